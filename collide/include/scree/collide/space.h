@@ -1,0 +1,65 @@
+// Space (AGX: agxCollide::Space): the set of geometries, pair filtering, the broadphase and the narrowphase.
+//
+// A pair is tested when both geometries have collisions enabled, they are not on the same body, at least one
+// is on a DYNAMICS body (or one is a sensor and the other moves), no disabled group pair, geometry pair or body
+// pair applies. Output: one GeometryContact per touching pair, ordered by (lower geometry id, higher id);
+// geometry 0 is the one with the lower id.
+#pragma once
+
+#include <cstdint>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "scree/collide/geometry.h"
+#include "scree/collide/uniform_grid.h"
+#include "scree/core/contact.h"
+
+namespace scree {
+
+class Space {
+ public:
+  void add(GeometryRef g);
+  bool remove(const GeometryRef& g);
+  bool contains(const Geometry* g) const;
+  const std::vector<GeometryRef>& getGeometries() const { return geoms_; }
+
+  /// Group pair switch (symmetric; a group with itself is allowed).
+  void setEnablePair(uint32_t group1, uint32_t group2, bool enable);
+  bool getEnablePair(uint32_t group1, uint32_t group2) const;
+  /// Geometry pair and body pair switches (a joint disables its two bodies by default).
+  void setEnableCollisions(const Geometry* a, const Geometry* b, bool enable);
+  void setEnableCollisions(const RigidBody* a, const RigidBody* b, bool enable);
+  bool canCollide(const Geometry& a, const Geometry& b) const;
+
+  /// Distance added to every pair's speculative margin, m (default 1e-3): keeps resting contacts alive
+  /// across tiny separations so warm starting holds.
+  void setContactMargin(Real m);
+  Real getContactMargin() const { return margin_; }
+
+  UniformGrid& getBroadphase() { return grid_; }
+
+  /// Updates world transforms, computes AABBs grown by each body's motion over `h` (speculative contacts),
+  /// runs broad- and narrowphase and appends the touching pairs to `out` (cleared first).
+  void collide(Real h, std::vector<GeometryContact>& out);
+
+  /// Number of candidate pairs from the broadphase in the last collide().
+  size_t getNumBroadphasePairs() const { return numPairs_; }
+
+ private:
+  static uint64_t pairKey(uint32_t a, uint32_t b) {
+    return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
+  }
+  std::vector<GeometryRef> geoms_;
+  std::set<uint64_t> disabledGroups_, disabledGeoms_, disabledBodies_;
+  UniformGrid grid_;
+  Real margin_ = 1e-3;
+  size_t numPairs_ = 0;
+  // scratch
+  std::vector<Aabb> boxes_;
+  std::vector<Real> margins_;
+  std::vector<std::pair<uint32_t, uint32_t>> pairs_;
+  std::vector<ContactPoint> scratchPoints_;
+};
+
+}  // namespace scree

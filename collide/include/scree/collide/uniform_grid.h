@@ -1,0 +1,44 @@
+// Uniform-grid broadphase.
+//
+// Finite AABBs are binned into cubic cells of a hashed grid (cell size chosen from the size distribution:
+// by default twice the median of the boxes' largest extents, overridable). Boxes larger than
+// `oversizeFactor` cells along any axis (big static boxes), and infinite ones (planes), go to a separate
+// list; each of those is tested against every finite box by AABB and against the other oversize ones.
+// Candidate pairs are emitted once, as (lower index, higher index), in sorted order so results are
+// deterministic. Cost is linear in N for evenly sized objects.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "scree/core/math.h"
+
+namespace scree {
+
+class UniformGrid {
+ public:
+  /// 0 (default) = automatic from the box sizes.
+  void setCellSize(Real size);
+  Real getCellSize() const { return cellSize_; }
+  /// Cell size used by the last findPairs().
+  Real getUsedCellSize() const { return usedCellSize_; }
+  void setOversizeFactor(Real f);
+
+  /// All pairs (i, j), i < j, whose boxes overlap, sorted. Boxes with lo > hi (empty) are skipped.
+  void findPairs(const std::vector<Aabb>& boxes, std::vector<std::pair<uint32_t, uint32_t>>& outPairs);
+
+ private:
+  Real cellSize_ = 0;
+  Real usedCellSize_ = 0;
+  Real oversizeFactor_ = 8;
+  // Scratch kept between calls (no per-step allocation once warm).
+  std::vector<uint64_t> cellKeys_;
+  std::vector<uint32_t> cellItems_;
+  std::vector<uint32_t> oversize_;
+  std::vector<uint32_t> finite_;
+  std::vector<Real> sizes_;
+  std::vector<uint64_t> pairKeys_;
+};
+
+}  // namespace scree

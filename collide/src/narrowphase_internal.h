@@ -1,0 +1,140 @@
+// Private helpers shared by the narrowphase files (narrowphase.cpp, box_box.cpp, convex_convex.cpp,
+// heightfield_collide.cpp, ccd_adapter.cpp). Not installed.
+//
+// Every pair routine has the same signature: shapes and world transforms of geometry 0 and 1, the speculative
+// margin, and the output vector. It appends points (normal from shape 1 towards shape 0, depth > 0 overlap,
+// only depth >= -margin, at most 4) and returns how many it appended. The dispatch table in narrowphase.cpp
+// calls a routine with its arguments swapped when the caller's order is the reverse of the routine's, and
+// then flips the normals of the appended points.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "scree/collide/shapes.h"
+#include "scree/core/contact.h"
+#include "scree/core/math.h"
+
+namespace scree::detail {
+
+using CollideFn = int (*)(const Shape& s0, const Transform& t0, const Shape& s1, const Transform& t1, Real margin,
+                          std::vector<ContactPoint>& out);
+
+inline ContactPoint makeContact(const Vec3& point, const Vec3& normal, Real depth, uint32_t featureId) {
+  ContactPoint c;
+  c.point = point;
+  c.normal = normal;
+  c.depth = depth;
+  c.featureId = featureId;
+  return c;
+}
+
+/// Keeps at most `maxPoints` of out[begin..end) (in place, deepest first): the deepest point, the one farthest
+/// from it, then the two that span the largest signed area on either side of that segment (Gregorius, "Robust
+/// Contact Creation for Physics Simulations", GDC 2015). Returns the number kept.
+int reduceManifold(std::vector<ContactPoint>& out, size_t begin, int maxPoints = 4);
+
+/// Closest points between segments p1-q1 and p2-q2 (Ericson, RTCD 5.1.9): outS, outT in [0, 1].
+void closestSegmentSegment(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, Real& outS, Real& outT);
+
+/// Closest point of segment a-b to p; returns the parameter in [0, 1].
+inline Real closestOnSegment(const Vec3& a, const Vec3& b, const Vec3& p) {
+  const Vec3 ab = b - a;
+  const Real l2 = ab.squaredNorm();
+  if (l2 <= 0) return 0;
+  Real t = (p - a).dot(ab) / l2;
+  return t < 0 ? 0 : (t > 1 ? 1 : t);
+}
+
+/// Triangle Voronoi region of a closest point: 0 face, 1..3 edges (ab, bc, ca), 4..6 vertices (a, b, c).
+enum TriRegion : int { TRI_FACE = 0, TRI_EDGE_AB = 1, TRI_EDGE_BC = 2, TRI_EDGE_CA = 3, TRI_VERT_A = 4,
+                       TRI_VERT_B = 5, TRI_VERT_C = 6 };
+/// Closest point on triangle abc to p (Ericson, RTCD 5.1.5) and the region it lies in.
+Vec3 closestPointTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, int& outRegion);
+
+// --- convex polytopes (box adapter, Convex, height-field triangles) ------------------------------------------
+
+/// A convex polytope in world coordinates. Faces list vertex indices counter-clockwise seen from outside.
+struct Polytope {
+  struct Face {
+    uint32_t first = 0, count = 0;  ///< range in `indices`
+    Vec3 normal;                    ///< outward unit
+    Real offset = 0;                ///< normal . x on the face
+  };
+  std::vector<Vec3> verts;
+  std::vector<uint32_t> indices;
+  std::vector<Face> faces;
+  std::vector<std::pair<uint32_t, uint32_t>> edges;  ///< unique edges (vertex index pairs)
+  void clear() {
+    verts.clear();
+    indices.clear();
+    faces.clear();
+    edges.clear();
+  }
+};
+
+/// Box as an 8-vertex polytope. Vertex k has sign bit (k >> a) & 1 on axis a; faces ordered +x,-x,+y,-y,+z,-z.
+void makeBoxPolytope(const Vec3& halfExtents, const Transform& t, Polytope& out);
+/// Convex hull placed in the world (faces from Convex::getFaces).
+void makeConvexPolytope(const Convex& c, const Transform& t, Polytope& out);
+
+/// SAT over face normals and edge-pair axes, then reference/incident face clipping (or the closest points of the
+/// two supporting edges). Normal from B towards A. `idSalt` is mixed into feature ids. Appends at most 4 points.
+int collidePolytopes(const Polytope& a, const Polytope& b, Real margin, std::vector<ContactPoint>& out);
+
+// --- clipping shared by box-box and polytopes ----------------------------------------------------------------
+
+/// A vertex of the clipped incident polygon. Each vertex is the intersection of two "lines" (labels): incident
+/// edges are 0..63 and reference side planes are 64 + k. The label pair identifies the point from step to step
+/// (feature id). `out` is the label of the polygon edge that leaves this vertex.
+struct ClipVertex {
+  Vec3 p;
+  uint8_t la, lb, out;
+};
+
+/// Incident polygon from `n` world vertices: vertex k sits between incident edges k-1 and k.
+void initIncident(const Vec3* verts, int n, std::vector<ClipVertex>& poly);
+/// Sutherland-Hodgman: clips `poly` by the side planes of the reference polygon `ref` (n vertices,
+/// counter-clockwise about refNormal). `scratch` is reused storage.
+void clipToReference(std::vector<ClipVertex>& poly, const Vec3* ref, int n, const Vec3& refNormal,
+                     std::vector<ClipVertex>& scratch);
+/// True when a point already appended since `begin` lies within 1e-9 m (scaled) of the clipped point x: clipping a
+/// polygon whose vertices lie exactly on a side plane emits the same point twice.
+inline bool nearExisting(const std::vector<ContactPoint>& out, size_t begin, const Vec3& x) {
+  const Real tol = Real(1e-9) * (1 + x.cwiseAbs().maxCoeff());
+  for (size_t k = begin; k < out.size(); ++k)
+    if ((out[k].point - x).cwiseAbs().maxCoeff() <= tol) return true;
+  return false;
+}
+/// Feature label of a clipped vertex (14 bits).
+inline uint32_t clipLabel(const ClipVertex& v) {
+  const uint32_t a = v.la & 127, b = v.lb & 127;
+  return a < b ? (a << 7) | b : (b << 7) | a;
+}
+
+// --- pair routines (first shape type named first) -----------------------------------------------------------
+
+int collideBoxBox(const Shape&, const Transform&, const Shape&, const Transform&, Real, std::vector<ContactPoint>&);
+int collideConvexConvex(const Shape&, const Transform&, const Shape&, const Transform&, Real,
+                        std::vector<ContactPoint>&);
+int collideConvexBox(const Shape&, const Transform&, const Shape&, const Transform&, Real, std::vector<ContactPoint>&);
+int collideConvexPlane(const Shape&, const Transform&, const Shape&, const Transform&, Real,
+                       std::vector<ContactPoint>&);
+/// libccd (MPR, then GJK/EPA) for any two convex shapes with support(); one point per call.
+int collideCcd(const Shape&, const Transform&, const Shape&, const Transform&, Real, std::vector<ContactPoint>&);
+
+/// Shape vs height field: the normal points out of the height field (from shape 1 towards shape 0).
+int collideSphereHeightField(const Shape&, const Transform&, const Shape&, const Transform&, Real,
+                             std::vector<ContactPoint>&);
+int collideCapsuleHeightField(const Shape&, const Transform&, const Shape&, const Transform&, Real,
+                              std::vector<ContactPoint>&);
+int collideBoxHeightField(const Shape&, const Transform&, const Shape&, const Transform&, Real,
+                          std::vector<ContactPoint>&);
+int collideConvexHeightField(const Shape&, const Transform&, const Shape&, const Transform&, Real,
+                             std::vector<ContactPoint>&);
+int collideCylinderHeightField(const Shape&, const Transform&, const Shape&, const Transform&, Real,
+                               std::vector<ContactPoint>&);
+int collideLineHeightField(const Shape&, const Transform&, const Shape&, const Transform&, Real,
+                           std::vector<ContactPoint>&);
+
+}  // namespace scree::detail

@@ -1,0 +1,145 @@
+// Space: pair filtering, speculative AABBs, broadphase and narrowphase dispatch.
+//
+// Speculative margin per geometry (so fast bodies produce contacts before they tunnel):
+//   margin = contactMargin + h (|v| + |w| r)
+// with v, w the body's centre-of-mass linear and angular velocity and r the distance from the centre of mass
+// to the farthest corner of the geometry's AABB — an upper bound on how far any point of the geometry moves
+// in one step. Geometries without a body, or on a STATIC body, get contactMargin only. The pair's margin
+// passed to the narrowphase is the sum of both.
+//
+// Non-dynamic pairs: two geometries neither of which is on a DYNAMICS body are skipped, except when one of
+// them is a sensor and at least one of them is on a KINEMATICS body (a moving sensor sweeping static
+// geometry, or a static sensor watching a kinematic body). Two fully static geometries never pair: their
+// overlap cannot change.
+#include "scree/collide/space.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "scree/collide/narrowphase.h"
+#include "scree/core/errors.h"
+
+namespace scree {
+
+void Space::add(GeometryRef g) {
+  detail::requireNonNull("Space::add", "geometry", g.get());
+  if (contains(g.get())) return;  // adding twice is a no-op
+  geoms_.push_back(std::move(g));
+}
+
+bool Space::remove(const GeometryRef& g) {
+  auto it = std::find(geoms_.begin(), geoms_.end(), g);
+  if (it == geoms_.end()) return false;
+  geoms_.erase(it);
+  return true;
+}
+
+bool Space::contains(const Geometry* g) const {
+  return std::any_of(geoms_.begin(), geoms_.end(), [g](const GeometryRef& r) { return r.get() == g; });
+}
+
+void Space::setEnablePair(uint32_t group1, uint32_t group2, bool enable) {
+  if (enable) disabledGroups_.erase(pairKey(group1, group2));
+  else disabledGroups_.insert(pairKey(group1, group2));
+}
+
+bool Space::getEnablePair(uint32_t group1, uint32_t group2) const {
+  return disabledGroups_.count(pairKey(group1, group2)) == 0;
+}
+
+void Space::setEnableCollisions(const Geometry* a, const Geometry* b, bool enable) {
+  detail::requireNonNull("Space::setEnableCollisions", "a", a);
+  detail::requireNonNull("Space::setEnableCollisions", "b", b);
+  if (enable) disabledGeoms_.erase(pairKey(a->getId(), b->getId()));
+  else disabledGeoms_.insert(pairKey(a->getId(), b->getId()));
+}
+
+void Space::setEnableCollisions(const RigidBody* a, const RigidBody* b, bool enable) {
+  detail::requireNonNull("Space::setEnableCollisions", "a", a);
+  detail::requireNonNull("Space::setEnableCollisions", "b", b);
+  if (enable) disabledBodies_.erase(pairKey(a->getId(), b->getId()));
+  else disabledBodies_.insert(pairKey(a->getId(), b->getId()));
+}
+
+void Space::setContactMargin(Real m) {
+  detail::requireNonNegative("Space::setContactMargin", "margin", m);
+  margin_ = m;
+}
+
+bool Space::canCollide(const Geometry& a, const Geometry& b) const {
+  if (&a == &b) return false;
+  if (!a.getEnableCollisions() || !b.getEnableCollisions()) return false;
+  const RigidBody* ba = a.getRigidBody();
+  const RigidBody* bb = b.getRigidBody();
+  if (ba && ba == bb) return false;
+  const bool dynA = ba && ba->isDynamic(), dynB = bb && bb->isDynamic();
+  if (!dynA && !dynB) {
+    const bool sensor = a.isSensor() || b.isSensor();
+    const bool moving = (ba && ba->getMotionControl() == RigidBody::KINEMATICS) ||
+                        (bb && bb->getMotionControl() == RigidBody::KINEMATICS);
+    if (!(sensor && moving)) return false;
+  }
+  if (!disabledGroups_.empty())
+    for (uint32_t ga : a.getGroups())
+      for (uint32_t gb : b.getGroups())
+        if (disabledGroups_.count(pairKey(ga, gb))) return false;
+  if (!disabledGeoms_.empty() && disabledGeoms_.count(pairKey(a.getId(), b.getId()))) return false;
+  if (ba && bb && !disabledBodies_.empty() && disabledBodies_.count(pairKey(ba->getId(), bb->getId())))
+    return false;
+  return true;
+}
+
+void Space::collide(Real h, std::vector<GeometryContact>& out) {
+  out.clear();
+  if (!(std::isfinite(h) && h >= 0)) h = 0;  // no exceptions inside the step; Simulation validates h
+  const size_t n = geoms_.size();
+  boxes_.resize(n);
+  margins_.resize(n);
+
+  // --- transforms, speculative AABBs ---------------------------------------------------------------------
+  for (size_t i = 0; i < n; ++i) {
+    Geometry& g = *geoms_[i];
+    g.updateTransform();
+    Aabb box = g.getBoundingBox();
+    Real m = margin_;
+    const RigidBody* b = g.getRigidBody();
+    if (b && b->getMotionControl() != RigidBody::STATIC && h > 0) {
+      const Vec3 c = b->getCmPosition();
+      const Vec3 far = (box.lo - c).cwiseAbs().cwiseMax((box.hi - c).cwiseAbs());
+      Real r = far.norm();
+      if (!std::isfinite(r) || r > 1e290) r = 0;  // unbounded shapes (planes): no angular sweep term
+      const Real sweep = h * (b->getVelocity().norm() + b->getAngularVelocity().norm() * r);
+      if (std::isfinite(sweep)) m += sweep;
+    }
+    margins_[i] = m;
+    box.inflate(m);
+    boxes_[i] = box;
+  }
+
+  // --- broadphase ---------------------------------------------------------------------------------------
+  grid_.findPairs(boxes_, pairs_);
+  numPairs_ = pairs_.size();
+
+  // --- filter and narrowphase -----------------------------------------------------------------------------
+  for (const auto& [i, j] : pairs_) {
+    Geometry* ga = geoms_[i].get();
+    Geometry* gb = geoms_[j].get();
+    if (!canCollide(*ga, *gb)) continue;
+    Real pairMargin = margins_[i] + margins_[j];
+    if (ga->getId() > gb->getId()) std::swap(ga, gb);
+    scratchPoints_.clear();
+    if (collideGeometries(*ga, *gb, pairMargin, scratchPoints_) <= 0 || scratchPoints_.empty()) continue;
+    GeometryContact& c = out.emplace_back(ga, gb, ga->getRigidBody(), gb->getRigidBody());
+    c.points().assign(scratchPoints_.begin(), scratchPoints_.end());
+    c.setSensor(ga->isSensor() || gb->isSensor());
+  }
+
+  // Deterministic order by (geometry 0 id, geometry 1 id), independent of the geometry list order.
+  std::sort(out.begin(), out.end(), [](const GeometryContact& x, const GeometryContact& y) {
+    const uint32_t x0 = x.geometry(0)->getId(), y0 = y.geometry(0)->getId();
+    if (x0 != y0) return x0 < y0;
+    return x.geometry(1)->getId() < y.geometry(1)->getId();
+  });
+}
+
+}  // namespace scree

@@ -1,0 +1,165 @@
+// Hashed uniform grid (Teschner et al. 2003, "Optimized spatial hashing for collision detection of
+// deformable objects", for the cell hash).
+//
+// Algorithm per findPairs():
+//  1. Classify: empty boxes are skipped; infinite ones and boxes spanning more than oversizeFactor cells on an
+//     axis go to the oversize list; the rest are binned.
+//  2. Bin: one 64-bit word per (cell, box) = (32-bit cell hash << 32) | box index, sorted. Equal words (a box
+//     whose cells collide in the hash) are deduplicated, so within one hash bucket each box appears once.
+//  3. Pairs inside a bucket: two overlapping boxes share the cell that contains the max of their lo corners
+//     (it lies inside both boxes); the pair is reported only from the bucket of that "owner" cell. So every
+//     overlapping pair is found exactly once without a hash set, even across hash collisions.
+//  4. Oversize boxes are tested by AABB against all binned boxes and against each other.
+//  5. Pairs are gathered as (i << 32 | j) words and sorted, which gives the (i, j) lexicographic order.
+// Cost: O(N) cells for evenly sized boxes plus the sorts; the scratch vectors are members and keep their
+// capacity, so a warm grid does not allocate. Serial on purpose: the sort dominates and a parallel version
+// would need a deterministic merge; not worth it at the sizes seen so far.
+#include "scree/collide/uniform_grid.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "scree/core/errors.h"
+
+namespace scree {
+
+namespace {
+
+constexpr Real kInfiniteCoord = 1e299;  // |coordinate| beyond this counts as unbounded (planes use 1e300)
+
+bool isEmpty(const Aabb& b) {
+  // NaN compares false, so a NaN box is treated as empty (never reported).
+  return !(b.lo.x() <= b.hi.x() && b.lo.y() <= b.hi.y() && b.lo.z() <= b.hi.z());
+}
+
+bool isUnbounded(const Aabb& b) {
+  return !(b.lo.array().abs() < kInfiniteCoord).all() || !(b.hi.array().abs() < kInfiniteCoord).all();
+}
+
+/// Integer cell coordinate, clamped so the conversion never overflows for huge finite coordinates.
+int64_t cellCoord(Real x, Real invCell) {
+  const Real c = std::floor(x * invCell);
+  const Real lim = 4.0e18;
+  return int64_t(std::clamp(c, -lim, lim));
+}
+
+uint32_t cellHash(int64_t x, int64_t y, int64_t z) {
+  // Large primes from Teschner et al.; a final avalanche mixes the low bits used for sorting locality.
+  uint64_t h = uint64_t(x) * 73856093ull ^ uint64_t(y) * 19349663ull ^ uint64_t(z) * 83492791ull;
+  h ^= h >> 29;
+  h *= 0xbf58476d1ce4e5b9ull;
+  h ^= h >> 32;
+  return uint32_t(h);
+}
+
+}  // namespace
+
+void UniformGrid::setCellSize(Real size) {
+  detail::requireNonNegative("UniformGrid::setCellSize", "size", size);
+  cellSize_ = size;
+}
+
+void UniformGrid::setOversizeFactor(Real f) {
+  if (!(std::isfinite(f) && f >= 1)) detail::throwInvalid("UniformGrid::setOversizeFactor", "factor", f, "must be finite and >= 1");
+  oversizeFactor_ = f;
+}
+
+void UniformGrid::findPairs(const std::vector<Aabb>& boxes, std::vector<std::pair<uint32_t, uint32_t>>& outPairs) {
+  outPairs.clear();
+  cellKeys_.clear();
+  cellItems_.clear();
+  oversize_.clear();
+  finite_.clear();
+  sizes_.clear();
+  pairKeys_.clear();
+
+  // --- 1. classify -------------------------------------------------------------------------------------
+  const uint32_t n = uint32_t(boxes.size());
+  for (uint32_t i = 0; i < n; ++i) {
+    const Aabb& b = boxes[i];
+    if (isEmpty(b)) continue;
+    if (isUnbounded(b)) oversize_.push_back(i);
+    else {
+      finite_.push_back(i);
+      sizes_.push_back(b.extent().maxCoeff());
+    }
+  }
+
+  // --- cell size: explicit, or twice the median largest extent --------------------------------------------
+  Real cell = cellSize_;
+  if (!(cell > 0)) {
+    cell = 0;
+    if (!sizes_.empty()) {
+      auto mid = sizes_.begin() + sizes_.size() / 2;
+      std::nth_element(sizes_.begin(), mid, sizes_.end());
+      cell = 2 * *mid;
+      // Point-like boxes (median extent 0): fall back to the largest extent, then to 1 m.
+      if (!(cell > 0)) cell = *std::max_element(sizes_.begin(), sizes_.end());
+    }
+    if (!(cell > 0) || !std::isfinite(cell)) cell = 1;
+  }
+  usedCellSize_ = cell;
+  const Real inv = 1 / cell;
+
+  // --- 2. bin finite boxes (moving the too-large ones to the oversize list) --------------------------------
+  size_t kept = 0;
+  for (uint32_t i : finite_) {
+    const Aabb& b = boxes[i];
+    const int64_t x0 = cellCoord(b.lo.x(), inv), x1 = cellCoord(b.hi.x(), inv);
+    const int64_t y0 = cellCoord(b.lo.y(), inv), y1 = cellCoord(b.hi.y(), inv);
+    const int64_t z0 = cellCoord(b.lo.z(), inv), z1 = cellCoord(b.hi.z(), inv);
+    if (Real(x1 - x0 + 1) > oversizeFactor_ || Real(y1 - y0 + 1) > oversizeFactor_ ||
+        Real(z1 - z0 + 1) > oversizeFactor_) {
+      oversize_.push_back(i);
+      continue;
+    }
+    finite_[kept++] = i;
+    for (int64_t x = x0; x <= x1; ++x)
+      for (int64_t y = y0; y <= y1; ++y)
+        for (int64_t z = z0; z <= z1; ++z) cellKeys_.push_back((uint64_t(cellHash(x, y, z)) << 32) | i);
+  }
+  finite_.resize(kept);
+  std::sort(cellKeys_.begin(), cellKeys_.end());
+  cellKeys_.erase(std::unique(cellKeys_.begin(), cellKeys_.end()), cellKeys_.end());
+
+  // --- 3. pairs within each bucket, owner-cell rule -----------------------------------------------------
+  const size_t nk = cellKeys_.size();
+  for (size_t s = 0; s < nk;) {
+    const uint32_t key = uint32_t(cellKeys_[s] >> 32);
+    size_t e = s + 1;
+    while (e < nk && uint32_t(cellKeys_[e] >> 32) == key) ++e;
+    for (size_t p = s; p < e; ++p) {
+      const uint32_t a = uint32_t(cellKeys_[p]);
+      const Aabb& ba = boxes[a];
+      for (size_t q = p + 1; q < e; ++q) {
+        const uint32_t b = uint32_t(cellKeys_[q]);  // b > a: the bucket is sorted by index
+        const Aabb& bb = boxes[b];
+        if (!ba.overlaps(bb)) continue;
+        const Vec3 lo = ba.lo.cwiseMax(bb.lo);
+        if (cellHash(cellCoord(lo.x(), inv), cellCoord(lo.y(), inv), cellCoord(lo.z(), inv)) != key) continue;
+        pairKeys_.push_back((uint64_t(a) << 32) | b);
+      }
+    }
+    s = e;
+  }
+
+  // --- 4. oversize boxes against everything ---------------------------------------------------------------
+  for (size_t k = 0; k < oversize_.size(); ++k) {
+    const uint32_t o = oversize_[k];
+    const Aabb& bo = boxes[o];
+    for (uint32_t f : finite_)
+      if (bo.overlaps(boxes[f])) pairKeys_.push_back(o < f ? (uint64_t(o) << 32) | f : (uint64_t(f) << 32) | o);
+    for (size_t m = k + 1; m < oversize_.size(); ++m) {
+      const uint32_t o2 = oversize_[m];
+      if (bo.overlaps(boxes[o2]))
+        pairKeys_.push_back(o < o2 ? (uint64_t(o) << 32) | o2 : (uint64_t(o2) << 32) | o);
+    }
+  }
+
+  // --- 5. sorted output ------------------------------------------------------------------------------------
+  std::sort(pairKeys_.begin(), pairKeys_.end());
+  outPairs.reserve(pairKeys_.size());
+  for (uint64_t k : pairKeys_) outPairs.emplace_back(uint32_t(k >> 32), uint32_t(k));
+}
+
+}  // namespace scree

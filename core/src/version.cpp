@@ -1,0 +1,32 @@
+#include "scree/version.h"
+
+namespace scree {
+
+const char* getVersionString() { return "0.1.0"; }
+
+const char* getConfigurationString() {
+  return "Scree 0.1.0 ("
+#ifdef NDEBUG
+         "optimised"
+#else
+         "debug"
+#endif
+#ifdef SCREE_WITH_OPENMP
+         "; OpenMP on"
+#else
+         "; OpenMP off"
+#endif
+#ifdef SCREE_WITH_SUITESPARSE
+         "; SuiteSparse on"
+#else
+         "; SuiteSparse off"
+#endif
+#ifdef SCREE_ENABLE_ASSERTS
+         "; asserts on"
+#else
+         "; asserts off"
+#endif
+         ")";
+}
+
+}  // namespace scree

@@ -1,0 +1,124 @@
+// scree_demo: the demo the README's first command runs. A built-in scene showing what the engine does today:
+// a 10-box tower, a 6-row pyramid, a box sliding to rest on friction, a bouncing ball (restitution), a heavy
+// box on a light one (1000:1), and a mixed pile of spheres, capsules, cylinders and convex hulls dropped on the
+// ground. Prints a one-line summary per simulated second.
+//
+// Usage: scree_demo [seconds=5] [iterations=16]
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <scree/scree.h>
+
+using namespace scree;
+
+namespace {
+RigidBodyRef makeBody(Simulation& sim, ShapeRef shape, const Vec3& pos, const MaterialRef& mat, const std::string& name) {
+  auto body = std::make_shared<RigidBody>(name);
+  auto geom = std::make_shared<Geometry>(std::move(shape));
+  geom->setMaterial(mat);
+  body->add(geom);
+  body->setPosition(pos);
+  sim.add(body);
+  return body;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  const double seconds = argc > 1 ? std::atof(argv[1]) : 5.0;
+  const int iterations = argc > 2 ? std::atoi(argv[2]) : 16;
+  std::printf("%s\n", getConfigurationString());
+
+  Simulation sim;
+  sim.getSolver().setNumIterations(iterations);
+  sim.setUniformGravity(Vec3(0, 0, -9.81));
+
+  auto stone = std::make_shared<Material>("stone");
+  stone->setDensity(1000);
+  auto rubber = std::make_shared<Material>("rubber");
+  rubber->setDensity(1000);
+  auto& mm = sim.getMaterialManager();
+  auto cmStone = mm.getOrCreateContactMaterial(stone, stone);
+  cmStone->setFrictionCoefficient(0.5);
+  cmStone->setRestitution(0.0);
+  auto cmRubber = mm.getOrCreateContactMaterial(rubber, stone);
+  cmRubber->setRestitution(0.8);
+
+  auto groundGeom = std::make_shared<Geometry>(std::make_shared<Box>(Vec3(50, 50, 0.5)), "ground");
+  groundGeom->setMaterial(stone);
+  groundGeom->setPosition(Vec3(0, 0, -0.5));
+  sim.add(groundGeom);
+
+  // Tower of 10 unit cubes.
+  std::vector<RigidBodyRef> tower;
+  for (int i = 0; i < 10; ++i)
+    tower.push_back(makeBody(sim, std::make_shared<Box>(Vec3(0.5, 0.5, 0.5)), Vec3(-8, 0, 0.5 + i), stone, "tower"));
+  // Pyramid with a base of 6.
+  RigidBodyRef pyramidTop;
+  for (int row = 0; row < 6; ++row)
+    for (int k = 0; k < 6 - row; ++k)
+      pyramidTop = makeBody(sim, std::make_shared<Box>(Vec3(0.5, 0.5, 0.5)),
+                            Vec3(-1.01 * (5 - row) / 2.0 + 1.01 * k, 8, 0.5 + row), stone, "pyramid");
+  // A box sliding at 5 m/s.
+  auto slider = makeBody(sim, std::make_shared<Box>(Vec3(0.5, 0.5, 0.5)), Vec3(0, -8, 0.5), stone, "slider");
+  slider->setVelocity(Vec3(5, 0, 0));
+  // A rubber ball dropped from 2 m.
+  auto ball = makeBody(sim, std::make_shared<Sphere>(0.25), Vec3(8, 0, 2.25), rubber, "ball");
+  // 1000 kg box on a 1 kg box.
+  auto light = makeBody(sim, std::make_shared<Box>(Vec3(0.5, 0.5, 0.5)), Vec3(8, 8, 0.5), stone, "light");
+  light->setMass(1);
+  auto heavy = makeBody(sim, std::make_shared<Box>(Vec3(0.5, 0.5, 0.5)), Vec3(8, 8, 1.5), stone, "heavy");
+  heavy->setMass(1000);
+  // A pile of mixed shapes.
+  std::vector<Vec3> hull = {{-0.3, -0.2, -0.2}, {0.3, -0.2, -0.2}, {0, 0.3, -0.2}, {0, 0, 0.3}, {0.1, 0.1, -0.25}};
+  std::vector<RigidBodyRef> pile;
+  for (int i = 0; i < 24; ++i) {
+    ShapeRef s;
+    switch (i % 4) {
+      case 0: s = std::make_shared<Sphere>(0.2); break;
+      case 1: s = std::make_shared<Capsule>(0.15, 0.4); break;
+      case 2: s = std::make_shared<Cylinder>(0.2, 0.3); break;
+      default: s = std::make_shared<Convex>(hull); break;
+    }
+    const Vec3 p(-0.6 + 0.6 * (i % 3), -0.6 + 0.6 * ((i / 3) % 3), 1.0 + 0.7 * (i / 9));
+    auto b = makeBody(sim, s, p, stone, "pile");
+    b->setRotation(Quat(Eigen::AngleAxis<Real>(0.3 * i, Vec3(1, 2, 3).normalized())));
+    pile.push_back(b);
+  }
+
+  const Real towerTop0 = tower.back()->getPosition().z();
+  const Real pyramidTop0 = pyramidTop->getPosition().z();
+  const Real sliderX0 = slider->getPosition().x();
+  Real ballApex = 0;
+  double solveTime = 0, totalTime = 0;
+  int steps = 0;
+  std::printf("%5s %9s %9s %9s %9s %9s %9s %8s %8s\n", "t[s]", "tower[cm]", "pyr[cm]", "slide[m]", "ball[m]",
+              "heavy[mm]", "pileKE[J]", "contacts", "ms/step");
+  while (sim.getTimeStamp() < seconds - 1e-9) {
+    sim.stepForward();
+    ++steps;
+    solveTime += sim.getStepStats().solve;
+    totalTime += sim.getStepStats().total;
+    ballApex = std::max<Real>(ballApex, ball->getPosition().z() - 0.25);
+    const Real t = sim.getTimeStamp();
+    if (std::abs(t - std::round(t)) < 0.5 * sim.getTimeStep()) {
+      Real ke = 0;
+      for (auto& b : pile) ke += b->getKineticEnergy();
+      const Vec3 top = tower.back()->getPosition();
+      std::printf("%5.1f %9.3f %9.3f %9.4f %9.3f %9.3f %9.4f %8zu %8.3f\n", t,
+                  100 * std::hypot(top.x() + 8, top.y()) + 100 * std::abs(top.z() - towerTop0),
+                  100 * std::abs(pyramidTop->getPosition().z() - pyramidTop0), slider->getPosition().x() - sliderX0,
+                  ballApex, 1000 * (heavy->getPosition().z() - 1.5), ke, sim.getStepStats().numContactPoints,
+                  1000 * totalTime / steps);
+      ballApex = 0;
+    }
+  }
+  const Real expectedSlide = 25.0 / (2 * 0.5 * 9.81);
+  std::printf("slider stopped after %.4f m (Coulomb: v^2/(2 mu g) = %.4f m)\n", slider->getPosition().x() - sliderX0,
+              expectedSlide);
+  std::printf("%d steps, %.3f ms/step (solve %.3f ms)\n", steps, 1000 * totalTime / steps, 1000 * solveTime / steps);
+  const auto& report = sim.getLastStepReport();
+  return report.ok() ? 0 : 1;
+}

@@ -1,0 +1,23 @@
+// Umbrella header: everything a Scree user needs.
+#pragma once
+
+#include "scree/core/contact.h"
+#include "scree/core/errors.h"
+#include "scree/core/listeners.h"
+#include "scree/core/logger.h"
+#include "scree/core/material.h"
+#include "scree/core/math.h"
+#include "scree/core/property_container.h"
+#include "scree/core/rigid_body.h"
+#include "scree/collide/execute_filters.h"
+#include "scree/collide/geometry.h"
+#include "scree/collide/narrowphase.h"
+#include "scree/collide/shapes.h"
+#include "scree/collide/space.h"
+#include "scree/collide/uniform_grid.h"
+#include "scree/solver/constraint.h"
+#include "scree/solver/joints.h"
+#include "scree/solver/simulation.h"
+#include "scree/solver/solver.h"
+#include "scree/solver/spook.h"
+#include "scree/version.h"

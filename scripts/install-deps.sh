@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages Scree's build needs, only those that are missing.
+#
+#   bash scripts/install-deps.sh [--with-plot] [--check]
+#
+#   --with-plot  also gnuplot-nox (plots of the benchmark sweeps; the build does not need it)
+#   --check      only report what is missing; exit 1 if something is
+#
+# As root: `apt-get update` (only when something is missing) and
+# `apt-get install -y --no-install-recommends <missing>` with DEBIAN_FRONTEND=noninteractive.
+# As another user: prints the exact command to run as root and exits 1.
+# Silent and exit 0 when everything is installed. SCREE_SKIP_DEPS=1 skips the check altogether
+# (non-Debian systems with the dependencies installed by other means).
+set -euo pipefail
+
+packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libccd-dev doctest-dev libbenchmark-dev)
+check_only=0
+for arg in "$@"; do
+  case "$arg" in
+    --with-plot) packages+=(gnuplot-nox) ;;
+    --check) check_only=1 ;;
+    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "install-deps.sh: unknown option '$arg' (try --help)" >&2; exit 2 ;;
+  esac
+done
+
+if [[ "${SCREE_SKIP_DEPS:-0}" == 1 ]]; then
+  exit 0
+fi
+if ! command -v dpkg-query >/dev/null 2>&1; then
+  echo "install-deps.sh: dpkg-query not found (not a Debian system?); install these by other means:" >&2
+  echo "  ${packages[*]}" >&2
+  echo "  (set SCREE_SKIP_DEPS=1 to silence this check)" >&2
+  exit 1
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
+  [[ "$status" == installed ]] || missing+=("$p")
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  exit 0
+fi
+
+install_cmd="apt-get install -y --no-install-recommends ${missing[*]}"
+if [[ $check_only -eq 1 ]]; then
+  echo "install-deps.sh: missing packages: ${missing[*]}" >&2
+  exit 1
+fi
+if [[ $(id -u) -ne 0 ]]; then
+  echo "install-deps.sh: missing packages: ${missing[*]}" >&2
+  echo "Run as root:" >&2
+  echo "  apt-get update && DEBIAN_FRONTEND=noninteractive $install_cmd" >&2
+  exit 1
+fi
+
+echo "+ apt-get update   (missing: ${missing[*]})"
+DEBIAN_FRONTEND=noninteractive apt-get update -q
+echo "+ $install_cmd"
+DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"

@@ -1,0 +1,36 @@
+// One scalar constraint row as the PGS and DIRECT solvers see it. Joints, contacts and models fill rows of
+// this form; solvers read only these and the body arrays (core types), so tests can feed hand-built rows.
+//
+// Row:  J = [jLinA, jAngA, jLinB, jAngB] acting on (v_a, w_a, v_b, w_b); body index -1 = world/static.
+// Solve: find lambda in [lo, hi] with (J M^-1 J^T + e) lambda = rhs - J v (PGS: one row at a time).
+#pragma once
+
+#include <cstdint>
+
+#include "scree/core/material.h"
+#include "scree/core/math.h"
+
+namespace scree {
+
+struct ConstraintRow {
+  int32_t bodyA = -1, bodyB = -1;  ///< indices into the solver body array, -1 = none
+  Vec3 jLinA = Vec3::Zero(), jAngA = Vec3::Zero();
+  Vec3 jLinB = Vec3::Zero(), jAngB = Vec3::Zero();
+  Real rhs = 0;     ///< target of J v+ + e lambda (velocity units)
+  Real e = 0;       ///< SPOOK regularisation
+  Real lo = -1e300, hi = 1e300;  ///< impulse bounds, N s
+  Real lambda = 0;  ///< accumulated impulse (warm start in, result out)
+  /// Friction rows: index of the normal row their bounds scale with (-1: fixed bounds), and mu.
+  int32_t normalRow = -1;
+  Real mu = 0;
+  /// Projected-cone friction: index of the partner tangent row (solved as a 2x2 block), or -1.
+  int32_t pairedRow = -1;
+  FrictionModel::SolveType solveType = FrictionModel::ITERATIVE;
+
+  // Filled by the solver's prepare step.
+  Vec3 mJLinA = Vec3::Zero(), mJAngA = Vec3::Zero(), mJLinB = Vec3::Zero(), mJAngB = Vec3::Zero();  ///< M^-1 J^T
+  Real invDiag = 0;                      ///< 1 / (J M^-1 J^T + e)
+  Real diag = 0;                         ///< J M^-1 J^T + e
+};
+
+}  // namespace scree

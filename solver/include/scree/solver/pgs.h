@@ -1,0 +1,35 @@
+// Projected Gauss-Seidel on the Schur form (DESIGN.md §4). Reads only core types and rows, so tests can feed
+// hand-built systems.
+//
+// Per row i: delta = (rhs_i - J_i v - e_i lambda_i) / (J_i M^-1 J_i^T + e_i), lambda_i <- clamp(lambda_i + delta),
+// v <- v + M^-1 J_i^T (clamped delta). Friction bounds follow the row's normal row (scaled box and the
+// projected cone use the current normal iterate, box uses fixed lo/hi). Paired tangent rows (projected cone)
+// get scalar updates at the same velocity, then the pair is projected onto the disc |lambda_t| <= mu lambda_n.
+// Warm starting: rows arrive with lambda from last step; prepare() applies those impulses first.
+#pragma once
+
+#include <vector>
+
+#include "scree/core/math.h"
+#include "scree/solver/constraint_row.h"
+#include "scree/solver/solver.h"
+
+namespace scree {
+
+/// Velocities and inverse mass of one body as the solver sees it (world frame, at the centre of mass).
+struct SolverBodyState {
+  Vec3 v = Vec3::Zero();
+  Vec3 w = Vec3::Zero();
+  Real invMass = 0;
+  Mat3 invInertia = Mat3::Zero();
+};
+
+class PgsSolver {
+ public:
+  /// Computes M^-1 J^T and the diagonals, then applies the warm-start impulses to the velocities.
+  static void prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies);
+  /// `iterations` sweeps over all rows in order. Returns the largest |delta lambda| of the last sweep.
+  static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations);
+};
+
+}  // namespace scree

@@ -1,0 +1,692 @@
+// Simulation: the step pipeline. The only solver file that includes collide headers.
+#include "scree/solver/simulation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "body_access.h"
+#include "integrator.h"
+#include "scree/collide/narrowphase.h"
+#include "scree/core/errors.h"
+#include "scree/core/logger.h"
+#include "scree/solver/pgs.h"
+#include "scree/solver/spook.h"
+
+namespace scree {
+
+using detail::BodyAccess;
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+uint64_t pairKeyOf(const GeometryContact& c) {
+  return (uint64_t(c.geometry(0)->getId()) << 32) | c.geometry(1)->getId();
+}
+// Rolling radius of a geometry for rolling resistance: spheres, cylinders and capsules roll; others do not.
+Real rollingRadius(const Geometry* g) {
+  const Shape* s = g->getShape().get();
+  switch (s->getType()) {
+    case Shape::SPHERE: return static_cast<const Sphere*>(s)->getRadius();
+    case Shape::CYLINDER: return static_cast<const Cylinder*>(s)->getRadius();
+    case Shape::CAPSULE: return static_cast<const Capsule*>(s)->getRadius();
+    default: return 0;
+  }
+}
+bool touching(const GeometryContact& c) {
+  for (const ContactPoint& p : c.points())
+    if (p.depth >= 0) return true;
+  return false;
+}
+}  // namespace
+
+struct Simulation::Impl {
+  // Per body (index = position in bodies_): solver state, start-of-step velocities, last finite pose.
+  std::vector<SolverBodyState> sb;
+  std::vector<Vec3> vStart, wStart;
+  std::vector<Vec3> savedX;
+  std::vector<Quat> savedQ;
+  std::vector<std::vector<Geometry*>> registered;  // geometries of each body known to the space
+
+  std::vector<ConstraintRow> rows;
+  // Contact point -> its rows.
+  struct PointRows {
+    uint32_t contact, point;
+    int32_t normal, t1;  // t1 = -1: no friction rows; t2 = t1 + 1
+    Vec3 tangent1, tangent2;
+    Real impactSpeed;
+  };
+  std::vector<PointRows> pointRows;
+  struct ConstraintRange {
+    Constraint* c;
+    uint32_t begin, count;
+  };
+  std::vector<ConstraintRange> ranges;
+  std::vector<int> rowDofs;
+
+  // Warm-start cache, sorted by (pair, feature).
+  struct CacheEntry {
+    uint64_t pair;
+    uint32_t feature;
+    Real normal;
+    Vec3 friction;
+    Real impactSpeed;
+    bool operator<(const CacheEntry& o) const { return pair != o.pair ? pair < o.pair : feature < o.feature; }
+  };
+  std::vector<CacheEntry> cache, nextCache;
+  // Touching pairs of the last step (sorted) with their geometries, for impact/separation events.
+  std::vector<std::pair<uint64_t, std::pair<Geometry*, Geometry*>>> prevPairs, curPairs;
+  bool warnedSolveType = false;
+
+  const CacheEntry* find(uint64_t pair, uint32_t feature) const {
+    CacheEntry key{pair, feature, 0, Vec3::Zero(), 0};
+    auto it = std::lower_bound(cache.begin(), cache.end(), key);
+    if (it != cache.end() && it->pair == pair && it->feature == feature) return &*it;
+    return nullptr;
+  }
+};
+
+Simulation::Simulation() : impl_(std::make_unique<Impl>()) {}
+Simulation::~Simulation() {
+  for (auto& b : bodies_) BodyAccess::simIndex(*b) = -1;
+}
+
+// ---- membership --------------------------------------------------------------------------------------------
+
+void Simulation::add(RigidBodyRef body) {
+  detail::requireNonNull("Simulation::add", "rigidBody", body.get());
+  int& idx = BodyAccess::simIndex(*body);
+  if (idx >= 0) {
+    if (size_t(idx) < bodies_.size() && bodies_[idx] == body) return;
+    throw std::invalid_argument("Simulation::add: rigidBody \"" + body->getName() +
+                                "\" is invalid (already in another simulation)");
+  }
+  idx = int(bodies_.size());
+  bodies_.push_back(body);
+  impl_->registered.emplace_back();
+  for (const GeometryRef& g : body->getGeometries()) {
+    space_.add(g);
+    impl_->registered.back().push_back(g.get());
+  }
+}
+
+bool Simulation::remove(const RigidBodyRef& body) {
+  if (!body) return false;
+  int idx = BodyAccess::simIndex(*body);
+  if (idx < 0 || size_t(idx) >= bodies_.size() || bodies_[idx] != body) return false;
+  for (Geometry* g : impl_->registered[idx]) {
+    for (const GeometryRef& ref : space_.getGeometries())
+      if (ref.get() == g) {
+        GeometryRef keep = ref;
+        space_.remove(keep);
+        break;
+      }
+  }
+  const size_t last = bodies_.size() - 1;
+  if (size_t(idx) != last) {
+    bodies_[idx] = bodies_[last];
+    impl_->registered[idx] = std::move(impl_->registered[last]);
+    BodyAccess::simIndex(*bodies_[idx]) = idx;
+  }
+  bodies_.pop_back();
+  impl_->registered.pop_back();
+  BodyAccess::simIndex(*body) = -1;
+  // Forget event state involving the body's geometries.
+  auto& pp = impl_->prevPairs;
+  pp.erase(std::remove_if(pp.begin(), pp.end(),
+                          [&](const auto& e) {
+                            return e.second.first->getRigidBody() == body.get() ||
+                                   e.second.second->getRigidBody() == body.get();
+                          }),
+           pp.end());
+  return true;
+}
+
+void Simulation::add(GeometryRef geometry) {
+  detail::requireNonNull("Simulation::add", "geometry", geometry.get());
+  if (geometry->getRigidBody() != nullptr)
+    throw std::invalid_argument("Simulation::add: geometry \"" + geometry->getName() +
+                                "\" is invalid (it belongs to a body: add the body instead)");
+  if (space_.contains(geometry.get())) return;
+  space_.add(geometry);
+  staticGeoms_.push_back(std::move(geometry));
+}
+
+bool Simulation::remove(const GeometryRef& geometry) {
+  auto it = std::find(staticGeoms_.begin(), staticGeoms_.end(), geometry);
+  if (it == staticGeoms_.end()) return false;
+  space_.remove(geometry);
+  staticGeoms_.erase(it);
+  auto& pp = impl_->prevPairs;
+  pp.erase(std::remove_if(pp.begin(), pp.end(),
+                          [&](const auto& e) {
+                            return e.second.first == geometry.get() || e.second.second == geometry.get();
+                          }),
+           pp.end());
+  return true;
+}
+
+void Simulation::add(ConstraintRef c) {
+  detail::requireNonNull("Simulation::add", "constraint", c.get());
+  if (std::find(constraints_.begin(), constraints_.end(), c) != constraints_.end()) return;
+  constraints_.push_back(c);
+  if (!c->getEnableCollisions()) space_.setEnableCollisions(c->getBodyAt(0), c->getBodyAt(1), false);
+}
+
+bool Simulation::remove(const ConstraintRef& c) {
+  auto it = std::find(constraints_.begin(), constraints_.end(), c);
+  if (it == constraints_.end()) return false;
+  constraints_.erase(it);
+  // Re-enable the pair unless another constraint still joins the same bodies without collisions.
+  bool stillJoined = false;
+  for (const auto& o : constraints_)
+    if (!o->getEnableCollisions() &&
+        ((o->getBodyAt(0) == c->getBodyAt(0) && o->getBodyAt(1) == c->getBodyAt(1)) ||
+         (o->getBodyAt(0) == c->getBodyAt(1) && o->getBodyAt(1) == c->getBodyAt(0))))
+      stillJoined = true;
+  if (!stillJoined) space_.setEnableCollisions(c->getBodyAt(0), c->getBodyAt(1), true);
+  return true;
+}
+
+void Simulation::add(StepEventListenerRef l) {
+  detail::requireNonNull("Simulation::add", "stepEventListener", l.get());
+  if (std::find(stepListeners_.begin(), stepListeners_.end(), l) != stepListeners_.end()) return;
+  l->setSimulation(this);
+  stepListeners_.push_back(std::move(l));
+}
+bool Simulation::remove(const StepEventListenerRef& l) {
+  auto it = std::find(stepListeners_.begin(), stepListeners_.end(), l);
+  if (it == stepListeners_.end()) return false;
+  (*it)->setSimulation(nullptr);
+  stepListeners_.erase(it);
+  return true;
+}
+void Simulation::add(ContactEventListenerRef l) {
+  detail::requireNonNull("Simulation::add", "contactEventListener", l.get());
+  if (std::find(contactListeners_.begin(), contactListeners_.end(), l) != contactListeners_.end()) return;
+  l->setSimulation(this);
+  contactListeners_.push_back(std::move(l));
+}
+bool Simulation::remove(const ContactEventListenerRef& l) {
+  auto it = std::find(contactListeners_.begin(), contactListeners_.end(), l);
+  if (it == contactListeners_.end()) return false;
+  (*it)->setSimulation(nullptr);
+  contactListeners_.erase(it);
+  return true;
+}
+
+void Simulation::setTimeStep(Real h) {
+  detail::requirePositive("Simulation::setTimeStep", "timeStep", h);
+  h_ = h;
+}
+void Simulation::setUniformGravity(const Vec3& g) {
+  detail::requireFinite("Simulation::setUniformGravity", "gravity", g);
+  gravity_ = g;
+}
+void Simulation::setEnableCollisions(const std::string& a, const std::string& b, bool enable) {
+  space_.setEnablePair(Geometry::groupId(a), Geometry::groupId(b), enable);
+}
+
+int Simulation::solverIndex(const RigidBody* b) const {
+  if (!b) return -1;
+  const int i = BodyAccess::simIndex(const_cast<RigidBody&>(*b));
+  return (i >= 0 && size_t(i) < bodies_.size() && bodies_[i].get() == b) ? i : -1;
+}
+
+// ---- the step ----------------------------------------------------------------------------------------------
+
+void Simulation::stepForward() {
+  const auto t0 = Clock::now();
+  report_ = StepReport{};
+  auto timed = [](double& slot, auto&& fn) {
+    const auto s = Clock::now();
+    fn();
+    slot = since(s);
+  };
+  timed(stats_.preCollide, [&] { runPreCollide(); });
+  timed(stats_.collide, [&] { runCollide(); });
+  timed(stats_.contactEvents, [&] { runContactEvents(); });
+  timed(stats_.pre, [&] { runPre(); });
+  timed(stats_.rows, [&] { buildRows(); });
+  timed(stats_.solve, [&] { solve(); });
+  timed(stats_.integrate, [&] {
+    integrate();
+    storeContactResults();
+    checkFinite();
+  });
+  time_ += h_;
+  timed(stats_.post, [&] { runPost(); });
+  stats_.total = since(t0);
+}
+
+void Simulation::stepTo(Real time) {
+  detail::requireFinite("Simulation::stepTo", "time", time);
+  while (time_ < time - 0.5 * h_) stepForward();
+}
+
+void Simulation::runPreCollide() {
+  for (auto& l : stepListeners_)
+    if (l->getMask() & StepEventListener::PRE_COLLIDE) l->preCollide(time_);
+}
+
+void Simulation::runCollide() {
+  // Pick up geometries added to or removed from bodies since the last step.
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    const auto& geoms = bodies_[i]->getGeometries();
+    auto& reg = impl_->registered[i];
+    bool same = geoms.size() == reg.size();
+    for (size_t k = 0; same && k < geoms.size(); ++k) same = geoms[k].get() == reg[k];
+    if (same) continue;
+    for (Geometry* g : reg) {
+      bool kept = false;
+      for (const auto& ng : geoms) kept |= ng.get() == g;
+      if (!kept)
+        for (const GeometryRef& ref : space_.getGeometries())
+          if (ref.get() == g) {
+            GeometryRef keep = ref;
+            space_.remove(keep);
+            break;
+          }
+    }
+    for (const auto& ng : geoms)
+      if (!space_.contains(ng.get())) space_.add(ng);
+    reg.clear();
+    for (const auto& ng : geoms) reg.push_back(ng.get());
+  }
+  space_.collide(h_, contacts_);
+  stats_.numBroadphasePairs = space_.getNumBroadphasePairs();
+
+  // Resolve contact parameters per pair.
+  for (GeometryContact& c : contacts_) {
+    const Material* m0 = c.geometry(0)->getMaterial().get();
+    const Material* m1 = c.geometry(1)->getMaterial().get();
+    const FrictionModel* fm = nullptr;
+    materials_.resolve(m0, m1, c.material(), &fm);
+    c.setFrictionModel(fm);
+  }
+}
+
+void Simulation::runContactEvents() {
+  auto& cur = impl_->curPairs;
+  auto& prev = impl_->prevPairs;
+  cur.clear();
+  bool anyRemoved = false;
+  for (GeometryContact& c : contacts_) {
+    if (!touching(c)) {
+      // Speculative only: solved (so nothing tunnels), but no events; sensors ignore it.
+      if (c.isSensor()) c.setEnable(false);
+      continue;
+    }
+    const uint64_t key = pairKeyOf(c);
+    auto it = std::lower_bound(prev.begin(), prev.end(), key, [](const auto& e, uint64_t k) { return e.first < k; });
+    const bool impact = !(it != prev.end() && it->first == key);
+    c.setImpact(impact);
+    cur.push_back({key, {c.geometry(0), c.geometry(1)}});
+    for (auto& l : contactListeners_) {
+      const int want = impact ? ContactEventListener::IMPACT : ContactEventListener::CONTACT;
+      if (!(l->getMask() & want) || !l->matches(c.geometry(0), c.geometry(1))) continue;
+      const auto policy = impact ? l->impact(time_, c) : l->contact(time_, c);
+      if (policy == ContactEventListener::REMOVE_CONTACT) {
+        c.setEnable(false);
+        c.points().clear();
+        anyRemoved = true;
+        break;
+      }
+    }
+  }
+  // Separation: touching last step, not now (cur is sorted because contacts are).
+  bool wantSeparation = false;
+  for (auto& l : contactListeners_) wantSeparation |= (l->getMask() & ContactEventListener::SEPARATION) != 0;
+  if (wantSeparation) {
+    size_t j = 0;
+    for (const auto& e : prev) {
+      while (j < cur.size() && cur[j].first < e.first) ++j;
+      if (j < cur.size() && cur[j].first == e.first) continue;
+      for (auto& l : contactListeners_)
+        if ((l->getMask() & ContactEventListener::SEPARATION) && l->matches(e.second.first, e.second.second))
+          l->separation(time_, e.second.first, e.second.second);
+    }
+  }
+  std::swap(prev, cur);
+  if (anyRemoved)
+    contacts_.erase(std::remove_if(contacts_.begin(), contacts_.end(),
+                                   [](const GeometryContact& c) { return c.points().empty(); }),
+                    contacts_.end());
+}
+
+void Simulation::runPre() {
+  for (auto& l : stepListeners_)
+    if (l->getMask() & StepEventListener::PRE_STEP) l->pre(time_);
+}
+
+void Simulation::buildRows() {
+  Impl& m = *impl_;
+  const size_t nb = bodies_.size();
+  m.sb.resize(nb);
+  m.vStart.resize(nb);
+  m.wStart.resize(nb);
+  m.savedX.resize(nb);
+  m.savedQ.resize(nb);
+  const Real h = h_;
+
+  // External forces and damping give the free velocities (v + h M^-1 f); gyroscopic effects are handled by
+  // the rotation integrator (integrator.h).
+  size_t numDynamic = 0;
+  for (size_t i = 0; i < nb; ++i) {
+    RigidBody& b = *bodies_[i];
+    SolverBodyState& s = m.sb[i];
+    m.vStart[i] = b.getVelocity();
+    m.wStart[i] = b.getAngularVelocity();
+    m.savedX[i] = BodyAccess::cm(b);
+    m.savedQ[i] = BodyAccess::rotation(b);
+    if (b.getMotionControl() == RigidBody::DYNAMICS) {
+      ++numDynamic;
+      s.invMass = b.getInvMass();
+      s.invInertia = b.getInvInertiaWorld();
+      s.v = (b.getVelocity() + h * (gravity_ + b.getForce() * s.invMass)) / (1.0 + h * b.getLinearVelocityDamping());
+      s.w = (b.getAngularVelocity() + h * (s.invInertia * b.getTorque())) / (1.0 + h * b.getAngularVelocityDamping());
+    } else {
+      s.invMass = 0;
+      s.invInertia.setZero();
+      s.v = b.getMotionControl() == RigidBody::KINEMATICS ? b.getVelocity() : Vec3::Zero();
+      s.w = b.getMotionControl() == RigidBody::KINEMATICS ? b.getAngularVelocity() : Vec3::Zero();
+    }
+  }
+
+  m.rows.clear();
+  m.pointRows.clear();
+  const Real threshold = solver_.getRestitutionThreshold();
+  const Real maxRecovery = solver_.getMaxPenetrationRecoverySpeed();
+  const bool warm = solver_.getUseWarmStarting();
+  size_t numPoints = 0, numWarm = 0, numSolvedContacts = 0;
+  bool nonIterative = false;
+
+  for (uint32_t ci = 0; ci < contacts_.size(); ++ci) {
+    GeometryContact& c = contacts_[ci];
+    if (!c.isEnabled() || c.isSensor()) continue;
+    const int ia = solverIndex(c.rigidBody(0)), ib = solverIndex(c.rigidBody(1));
+    const bool dynA = ia >= 0 && m.sb[ia].invMass > 0, dynB = ib >= 0 && m.sb[ib].invMass > 0;
+    if (!dynA && !dynB) continue;
+    const SurfaceParameters& mat = c.material();
+    const FrictionModel* fm = c.frictionModel();
+    const FrictionModel::Type ftype = fm ? fm->getType() : FrictionModel::ITERATIVE_PROJECTED_CONE;
+    if (fm && fm->getSolveType() != FrictionModel::ITERATIVE) nonIterative = true;
+    const uint64_t pair = pairKeyOf(c);
+    const Vec3 xa = ia >= 0 ? BodyAccess::cm(*bodies_[ia]) : Vec3::Zero();
+    const Vec3 xb = ib >= 0 ? BodyAccess::cm(*bodies_[ib]) : Vec3::Zero();
+    const Vec3 va0 = ia >= 0 ? m.vStart[ia] : Vec3::Zero(), wa0 = ia >= 0 ? m.wStart[ia] : Vec3::Zero();
+    const Vec3 vb0 = ib >= 0 ? m.vStart[ib] : Vec3::Zero(), wb0 = ib >= 0 ? m.wStart[ib] : Vec3::Zero();
+
+    // Rolling resistance: resisting torque about the tangents bounded by coefficient * r_eff * normal force,
+    // r_eff the harmonic combination of the rolling radii (the single radius against a flat shape).
+    Real rollMu = 0;
+    if (mat.getRollingResistanceCoefficient() > 0) {
+      const Real r0 = rollingRadius(c.geometry(0)), r1 = rollingRadius(c.geometry(1));
+      const Real reff = (r0 > 0 && r1 > 0) ? r0 * r1 / (r0 + r1) : std::max(r0, r1);
+      rollMu = mat.getRollingResistanceCoefficient() * reff;
+    }
+    // Count active points to lay out rows: [friction and rolling rows of all points][normal rows].
+    auto& pts = c.points();
+    uint32_t nActive = 0, nFriction = 0;
+    for (const ContactPoint& p : pts) {
+      if (!p.enabled) continue;
+      ++nActive;
+      const Real mu = p.frictionCoefficient >= 0 ? p.frictionCoefficient : mat.getFrictionCoefficient();
+      if (mu > 0) nFriction += 2;
+      if (rollMu > 0) nFriction += 2;
+    }
+    if (nActive == 0) continue;
+    ++numSolvedContacts;
+    const int32_t base = int32_t(m.rows.size());
+    int32_t nextFriction = base;
+    int32_t nextNormal = base + int32_t(nFriction);
+    m.rows.resize(m.rows.size() + nFriction + nActive);
+    // Weight-based normal impulse estimate for box friction on new contacts: the lighter dynamic body's weight.
+    const Real massA = dynA ? 1.0 / m.sb[ia].invMass : 0, massB = dynB ? 1.0 / m.sb[ib].invMass : 0;
+    const Real weightImpulse =
+        ((dynA && dynB) ? std::min(massA, massB) : std::max(massA, massB)) * gravity_.norm() * h / Real(nActive);
+
+    for (uint32_t pi = 0; pi < pts.size(); ++pi) {
+      ContactPoint& p = pts[pi];
+      if (!p.enabled) continue;
+      ++numPoints;
+      const Vec3& n = p.normal;
+      const Vec3 ra = p.point - xa, rb = p.point - xb;
+      const Impl::CacheEntry* ce = warm ? m.find(pair, p.featureId) : nullptr;
+      if (ce) ++numWarm;
+
+      // --- normal row ---
+      ConstraintRow& r = m.rows[nextNormal];
+      r = ConstraintRow{};
+      r.bodyA = ia;
+      r.bodyB = ib;
+      r.jLinA = n;
+      r.jAngA = ra.cross(n);
+      r.jLinB = -n;
+      r.jAngB = -rb.cross(n);
+      r.solveType = fm ? fm->getSolveType() : FrictionModel::ITERATIVE;
+      const Real vn0 = r.jLinA.dot(va0) + r.jAngA.dot(wa0) + r.jLinB.dot(vb0) + r.jAngB.dot(wb0);
+      Real impactSpeed = 0;
+      const Real adhesiveForce = mat.getAdhesiveForce();
+      const Real rest = p.restitution >= 0 ? p.restitution : mat.getRestitution();
+      const Real remembered = ce ? ce->impactSpeed : 0;
+      if (p.depth < 0 && adhesiveForce <= 0) {
+        // Speculative: allow the approach to close the gap within this step, no force before that.
+        r.rhs = p.depth / h;
+        r.e = 0;
+        r.lo = 0;
+        const Real vnFree = r.jLinA.dot(ia >= 0 ? m.sb[ia].v : Vec3::Zero()) +
+                            r.jAngA.dot(ia >= 0 ? m.sb[ia].w : Vec3::Zero()) +
+                            r.jLinB.dot(ib >= 0 ? m.sb[ib].v : Vec3::Zero()) +
+                            r.jAngB.dot(ib >= 0 ? m.sb[ib].w : Vec3::Zero());
+        if (remembered > threshold) {
+          // Last step closed the gap at the remembered speed: the surfaces touch now, bounce from here.
+          r.rhs = std::max(r.rhs, rest * remembered);
+        } else if (vnFree * h < p.depth && -vnFree > threshold) {
+          // The free motion closes the gap this step: the row stops the body exactly at the surface. Remember the
+          // approach speed so next step's impact stage uses the true speed, not the clamped one.
+          impactSpeed = -vnFree;
+        }
+      } else {
+        const Real E = p.youngsModulus > 0 ? p.youngsModulus : mat.getYoungsModulus();
+        const Real tau = p.damping >= 0 ? p.damping : mat.getDamping();
+        // Adhesion: the contact's adhesive force is shared by its points; while the pair is in contact (points
+        // within the contact margin) the row may pull with up to that force towards the rest overlap.
+        const Real adhF = adhesiveForce / Real(nActive), adhO = mat.getAdhesiveOverlap();
+        const SpookCoefficients co = spookHolonomic(h, 1.0 / E, tau);
+        // g is the constraint violation: negative when the overlap exceeds the rest overlap.
+        const Real g = (adhF > 0 ? adhO : 0.0) - p.depth;
+        Real bias = -co.a * g;
+        if (maxRecovery > 0) bias = std::min(bias, maxRecovery);
+        r.rhs = bias + co.upsilon * vn0;
+        r.e = co.e;
+        r.lo = adhF > 0 ? (std::isinf(adhF) ? -1e300 : -adhF * h) : 0.0;
+        // Impact stage: an approach faster than the threshold (now, or remembered from a speculative step)
+        // gets the Newtonian target v_n+ = e * approach speed instead of the soft spring.
+        const Real approach = std::max(remembered, -vn0);
+        if (approach > threshold) r.rhs = std::max(r.rhs, rest * approach);
+      }
+      r.hi = 1e300;
+      r.lambda = ce ? std::max(ce->normal, r.lo) : 0.0;
+
+      // --- friction rows ---
+      const Real mu = p.frictionCoefficient >= 0 ? p.frictionCoefficient : mat.getFrictionCoefficient();
+      int32_t t1Index = -1;
+      Vec3 t1, t2;
+      orthonormalBasis(n, t1, t2);
+      if (mu > 0) {
+        t1Index = nextFriction;
+        const Real eVisc = spookVelocityRegularisation(h, mat.getSurfaceViscosity());
+        const Real lnEst = ce && ce->normal > 0 ? ce->normal : weightImpulse;
+        for (int k = 0; k < 2; ++k) {
+          const Vec3& t = k == 0 ? t1 : t2;
+          ConstraintRow& f = m.rows[nextFriction + k];
+          f = ConstraintRow{};
+          f.bodyA = ia;
+          f.bodyB = ib;
+          f.jLinA = t;
+          f.jAngA = ra.cross(t);
+          f.jLinB = -t;
+          f.jAngB = -rb.cross(t);
+          f.rhs = p.surfaceVelocity.dot(t);
+          f.e = eVisc;
+          f.mu = mu;
+          f.solveType = r.solveType;
+          f.lambda = ce ? ce->friction.dot(t) : 0.0;
+          switch (ftype) {
+            case FrictionModel::BOX: {
+              const Real lim = std::isinf(mu) ? 1e300 : mu * lnEst;
+              f.lo = -lim;
+              f.hi = lim;
+              f.lambda = std::clamp(f.lambda, f.lo, f.hi);
+              break;
+            }
+            case FrictionModel::SCALED_BOX: f.normalRow = nextNormal; break;
+            case FrictionModel::ITERATIVE_PROJECTED_CONE:
+              f.normalRow = nextNormal;
+              if (k == 0) f.pairedRow = nextFriction + 1;
+              break;
+          }
+        }
+        nextFriction += 2;
+      }
+      if (rollMu > 0) {
+        // Two angular rows on the relative rotation about the tangents, solved as a disc like the cone.
+        for (int k = 0; k < 2; ++k) {
+          const Vec3& t = k == 0 ? t1 : t2;
+          ConstraintRow& f = m.rows[nextFriction + k];
+          f = ConstraintRow{};
+          f.bodyA = ia;
+          f.bodyB = ib;
+          f.jAngA = t;
+          f.jAngB = -t;
+          f.mu = rollMu;
+          f.normalRow = nextNormal;
+          f.solveType = r.solveType;
+          if (k == 0) f.pairedRow = nextFriction + 1;
+        }
+        nextFriction += 2;
+      }
+      m.pointRows.push_back({ci, pi, nextNormal, t1Index, t1, t2, impactSpeed});
+      ++nextNormal;
+    }
+  }
+
+  // Constraints (joints, models).
+  m.ranges.clear();
+  m.rowDofs.assign(m.rows.size(), -1);
+  for (auto& c : constraints_) {
+    if (!c->getEnable()) continue;
+    ConstraintContext ctx;
+    ctx.h = h;
+    ctx.indexA = solverIndex(c->getBodyAt(0));
+    ctx.indexB = solverIndex(c->getBodyAt(1));
+    const bool dynA = ctx.indexA >= 0 && m.sb[ctx.indexA].invMass > 0;
+    const bool dynB = ctx.indexB >= 0 && m.sb[ctx.indexB].invMass > 0;
+    if (!dynA && !dynB) continue;
+    const uint32_t begin = uint32_t(m.rows.size());
+    c->addRows(ctx, m.rows, m.rowDofs);
+    if (c->getSolveType() != FrictionModel::ITERATIVE) nonIterative = true;
+    m.ranges.push_back({c.get(), begin, uint32_t(m.rows.size() - begin)});
+  }
+  if (nonIterative && !m.warnedSolveType) {
+    m.warnedSolveType = true;
+    Logger::warningOnce("scree.solveType.direct",
+                        "DIRECT / SPLIT / DIRECT_AND_ITERATIVE solve types are not available yet: those rows are "
+                        "solved by the iterative PGS solver");
+  }
+
+  SolverStats& st = solver_.stats();
+  st.numBodies = numDynamic;
+  st.numContacts = numSolvedContacts;
+  st.numContactPoints = numPoints;
+  st.numRows = m.rows.size();
+  st.numWarmStarted = numWarm;
+  stats_.numContacts = contacts_.size();
+  stats_.numContactPoints = numPoints;
+}
+
+void Simulation::solve() {
+  Impl& m = *impl_;
+  if (m.rows.empty()) {
+    solver_.stats().numIterations = 0;
+    solver_.stats().lastResidual = 0;
+    return;
+  }
+  PgsSolver::prepare(m.rows, m.sb);
+  solver_.stats().lastResidual = PgsSolver::iterate(m.rows, m.sb, solver_.getNumIterations());
+  solver_.stats().numIterations = size_t(solver_.getNumIterations());
+}
+
+void Simulation::integrate() {
+  Impl& m = *impl_;
+  const Real h = h_;
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    RigidBody& b = *bodies_[i];
+    switch (b.getMotionControl()) {
+      case RigidBody::STATIC: break;
+      case RigidBody::KINEMATICS:
+        BodyAccess::cm(b) += h * b.getVelocity();
+        BodyAccess::rotation(b) = (detail::expRotation(b.getAngularVelocity(), h) * BodyAccess::rotation(b)).normalized();
+        break;
+      case RigidBody::DYNAMICS:
+        BodyAccess::velocity(b) = m.sb[i].v;
+        BodyAccess::angularVelocity(b) = m.sb[i].w;
+        BodyAccess::cm(b) += h * m.sb[i].v;
+        detail::integrateRotation(b, h);
+        break;
+    }
+    b.clearForces();
+  }
+}
+
+void Simulation::storeContactResults() {
+  Impl& m = *impl_;
+  const Real invH = 1.0 / h_;
+  m.nextCache.clear();
+  for (const Impl::PointRows& pr : m.pointRows) {
+    GeometryContact& c = contacts_[pr.contact];
+    ContactPoint& p = c.points()[pr.point];
+    const Real ln = m.rows[pr.normal].lambda;
+    Vec3 ft = Vec3::Zero();
+    if (pr.t1 >= 0) ft = m.rows[pr.t1].lambda * pr.tangent1 + m.rows[pr.t1 + 1].lambda * pr.tangent2;
+    p.normalImpulse = ln;
+    p.frictionImpulse = ft;
+    p.normalForce = ln * invH;
+    p.frictionForce = ft * invH;
+    p.impactSpeed = pr.impactSpeed;
+    m.nextCache.push_back({pairKeyOf(c), p.featureId, ln, ft, pr.impactSpeed});
+  }
+  std::sort(m.nextCache.begin(), m.nextCache.end());
+  std::swap(m.cache, m.nextCache);
+  for (const auto& r : m.ranges) r.c->storeResult(m.rows.data() + r.begin, m.rowDofs.data() + r.begin, r.count, h_);
+}
+
+void Simulation::checkFinite() {
+  Impl& m = *impl_;
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    RigidBody& b = *bodies_[i];
+    if (b.getMotionControl() == RigidBody::STATIC) continue;
+    if (BodyAccess::cm(b).allFinite() && BodyAccess::rotation(b).coeffs().allFinite() &&
+        BodyAccess::velocity(b).allFinite() && BodyAccess::angularVelocity(b).allFinite())
+      continue;
+    std::ostringstream msg;
+    msg << "RigidBody \"" << b.getName() << "\" (id " << b.getId() << ") has a non-finite state after the step at t = "
+        << time_ << " s; restored its last finite pose and stopped it";
+    BodyAccess::cm(b) = m.savedX[i];
+    BodyAccess::rotation(b) = m.savedQ[i];
+    BodyAccess::velocity(b).setZero();
+    BodyAccess::angularVelocity(b).setZero();
+    report_.nonFiniteBodies.push_back(b.getId());
+    report_.messages.push_back(msg.str());
+    Logger::error(msg.str());
+  }
+}
+
+void Simulation::runPost() {
+  for (auto& l : stepListeners_)
+    if (l->getMask() & StepEventListener::POST_STEP) l->post(time_);
+}
+
+}  // namespace scree

@@ -1,0 +1,22 @@
+#include "scree/solver/solver.h"
+
+#include "scree/core/errors.h"
+
+namespace scree {
+
+void Solver::setNumIterations(int n) {
+  if (n < 1) detail::throwInvalid("Solver::setNumIterations", "numIterations", (long long)n, "must be >= 1");
+  iterations_ = n;
+}
+
+void Solver::setRestitutionThreshold(Real v) {
+  detail::requireNonNegative("Solver::setRestitutionThreshold", "threshold", v);
+  restitutionThreshold_ = v;
+}
+
+void Solver::setMaxPenetrationRecoverySpeed(Real v) {
+  detail::requireNonNegative("Solver::setMaxPenetrationRecoverySpeed", "speed", v);
+  maxRecovery_ = v;
+}
+
+}  // namespace scree

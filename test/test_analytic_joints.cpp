@@ -1,0 +1,247 @@
+// Joints and compliant constraints against closed-form dynamics (issue: joints, compliant constraints).
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "test_world.h"
+
+using namespace scree;
+using namespace scree::test;
+
+namespace {
+// Complete elliptic integral of the first kind via the arithmetic-geometric mean: K(k) = pi / (2 AGM(1, k')).
+Real ellipticK(Real k) {
+  Real a = 1, b = std::sqrt(1 - k * k);
+  for (int i = 0; i < 40; ++i) {
+    const Real an = 0.5 * (a + b);
+    b = std::sqrt(a * b);
+    a = an;
+  }
+  return M_PI / (2 * a);
+}
+
+// A point-like bob (sphere r = 1 cm, so I_cm / (m L^2) = 4e-5) on a hinge about y at the origin, released at
+// angle theta0 from the downward vertical. Returns the mean period over `periods` full swings, measured from
+// upward zero crossings of the angle (linear interpolation between steps).
+Real pendulumPeriod(Real theta0, Real h, int periods) {
+  TestWorld w(h, 9.81);
+  const Real L = 1.0;
+  auto bob = w.addSphere(0.01, Vec3(L * std::sin(theta0), 0, -L * std::cos(theta0)), 1.0);
+  auto hinge = std::make_shared<Hinge>(bob, nullptr, Vec3::Zero(), Vec3::UnitY());
+  w.sim->add(hinge);
+  std::vector<Real> crossings;
+  Real prev = std::atan2(bob->getPosition().x(), -bob->getPosition().z());
+  while (crossings.size() < size_t(periods + 1) && w.time() < 100) {
+    w.sim->stepForward();
+    const Real a = std::atan2(bob->getPosition().x(), -bob->getPosition().z());
+    if (prev < 0 && a >= 0) crossings.push_back(w.time() - h * a / (a - prev));
+    prev = a;
+  }
+  REQUIRE(crossings.size() == size_t(periods + 1));
+  return (crossings.back() - crossings.front()) / periods;
+}
+}  // namespace
+
+TEST_SUITE("joints") {
+  TEST_CASE("simple pendulum at 5 degrees swings with period 2 pi sqrt(L/g)") {
+    // Tolerance 0.5 %: the finite amplitude adds theta0^2/16 = 0.048 %, the bob's own inertia 4e-5, symplectic
+    // Euler's phase error at omega h = 0.031 is (omega h)^2/24 = 4e-5, and the crossing interpolation error is
+    // well below h/100 over 10 periods. Compliance 1e-8 m/N stretches the 1 m rod by 1e-7 m.
+    const Real g = 9.81, L = 1.0;
+    const Real T = pendulumPeriod(5 * M_PI / 180, 0.01, 10);
+    const Real T0 = 2 * M_PI * std::sqrt(L / g);
+    MESSAGE("period " << T << " s, small-angle " << T0 << " s, rel err " << (T - T0) / T0);
+    CHECK(std::abs(T - T0) / T0 < 0.005);
+  }
+
+  TEST_CASE("pendulum at 60 degrees matches the elliptic-integral period") {
+    // T = 4 sqrt(L/g) K(sin(theta0/2)). Within 1 %: the discretisation errors above stay below 1e-3.
+    const Real g = 9.81, L = 1.0, th = M_PI / 3;
+    const Real T = pendulumPeriod(th, 0.01, 5);
+    const Real Te = 4 * std::sqrt(L / g) * ellipticK(std::sin(th / 2));
+    MESSAGE("period " << T << " s, elliptic " << Te << " s, rel err " << (T - Te) / Te);
+    CHECK(std::abs(T - Te) / Te < 0.01);
+  }
+
+  TEST_CASE("one compliant DOF oscillates at sqrt(k/m) and decays with damping ratio c/(2 sqrt(km))") {
+    const Real m = 2.0, k = 800.0;  // omega = 20 rad/s
+    const Real omega = std::sqrt(k / m);
+    const Real h = 0.1 / omega / 2;  // omega h = 0.05
+    auto run = [&](Real c, std::vector<Real>& peaks, std::vector<Real>& peakTimes) {
+      TestWorld w(h, 0.0);
+      auto body = w.addSphere(0.05, Vec3(0.1, 0, 0), m);
+      auto j = std::make_shared<Generic6DofJoint>(body, nullptr, Vec3::Zero());
+      j->setStiffness(Generic6DofJoint::TRANSLATIONAL_1, k, c);
+      w.sim->add(j);
+      Real x0 = body->getPosition().x(), x1 = x0;
+      for (int i = 0; i < int(6 * 2 * M_PI / omega / h); ++i) {
+        w.sim->stepForward();
+        const Real x2 = body->getPosition().x();
+        if (x1 > x0 && x1 >= x2 && x1 > 0) {
+          // Parabolic peak interpolation through the three samples.
+          const Real den = x0 - 2 * x1 + x2;
+          const Real off = den != 0 ? 0.5 * (x0 - x2) / den : 0;
+          peaks.push_back(x1 - 0.25 * (x0 - x2) * off);
+          peakTimes.push_back(w.time() - h + off * h);
+        }
+        x0 = x1;
+        x1 = x2;
+      }
+    };
+    std::vector<Real> peaks, times;
+    run(0.0, peaks, times);
+    REQUIRE(peaks.size() >= 4);
+    const Real period = (times.back() - times.front()) / Real(times.size() - 1);
+    const Real wMeasured = 2 * M_PI / period;
+    MESSAGE("omega " << wMeasured << " vs " << omega);
+    // 1 %: SPOOK's effective stiffness k/(1 + k h^2/(4 m)) and symplectic Euler shift omega by ~(omega h)^2/8.
+    CHECK(std::abs(wMeasured - omega) / omega < 0.01);
+    // Undamped: amplitude kept within 1 % over six periods (no numerical damping at d = 0).
+    CHECK(peaks.back() > 0.99 * peaks.front());
+
+    const Real zeta = 0.05, c = zeta * 2 * std::sqrt(k * m);
+    std::vector<Real> dpeaks, dtimes;
+    run(c, dpeaks, dtimes);
+    REQUIRE(dpeaks.size() >= 3);
+    // Logarithmic decrement delta = ln(A_n / A_n+1) = 2 pi zeta / sqrt(1 - zeta^2).
+    const Real delta = std::log(dpeaks.front() / dpeaks.back()) / Real(dpeaks.size() - 1);
+    const Real zetaMeasured = delta / std::sqrt(4 * M_PI * M_PI + delta * delta);
+    MESSAGE("damping ratio " << zetaMeasured << " vs " << zeta);
+    CHECK(std::abs(zetaMeasured - zeta) / zeta < 0.05);
+  }
+
+  TEST_CASE("hinge motor reaches its target speed, and stalls at its force limit") {
+    const Real h = 1.0 / 60;
+    TestWorld w(h, 0.0);
+    auto rotor = w.addBox(Vec3(0.5, 0.1, 0.1), Vec3::Zero(), 10.0);
+    auto hinge = std::make_shared<Hinge>(rotor, nullptr, Vec3::Zero(), Vec3::UnitZ());
+    hinge->getMotor1D().setEnable(true);
+    hinge->getMotor1D().setSpeed(2.0);
+    hinge->getMotor1D().setForceRange(-100, 100);
+    w.sim->add(hinge);
+    w.stepSeconds(1.0);
+    const Real speed = hinge->getCurrentSpeed();
+    MESSAGE("motor speed " << speed << " rad/s (target 2)");
+    // 1 %: the motor row's compliance 1e-10 lets the speed lag by force * 1e-10, negligible here.
+    CHECK(std::abs(speed - 2.0) / 2.0 < 0.01);
+    CHECK(std::abs(rotor->getAngularVelocity().z() - 2.0) < 0.02);
+
+    // Load torque 50 N m against a 20 N m motor: it stalls (cannot hold speed) and applies exactly its limit.
+    hinge->getMotor1D().setForceRange(-20, 20);
+    for (int i = 0; i < 60; ++i) {
+      rotor->addTorque(Vec3(0, 0, -50));
+      w.sim->stepForward();
+    }
+    const Real motorTorque = hinge->getMotor1D().getCurrentForce();
+    MESSAGE("stalled motor torque " << motorTorque << " N m, speed " << hinge->getCurrentSpeed());
+    CHECK(std::abs(motorTorque - 20.0) < 0.2);
+    CHECK(hinge->getCurrentSpeed() < 0.0);
+  }
+
+  TEST_CASE("prismatic range holds its limit within the compliance-predicted error") {
+    const Real h = 1.0 / 60, m = 10.0, g = 9.81, eps = 1e-5;
+    TestWorld w(h, g);
+    auto slider = w.addBox(Vec3(0.1, 0.1, 0.1), Vec3(0, 0, 0), m);
+    auto pr = std::make_shared<Prismatic>(slider, nullptr, Vec3::Zero(), Vec3::UnitZ());
+    pr->getRange1D().setEnable(true);
+    pr->getRange1D().setRange(-0.5, 0.5);
+    pr->getRange1D().setCompliance(eps);
+    w.sim->add(pr);
+    w.stepSeconds(3.0);
+    // At rest the range row is a spring 1/eps loaded by m g: position = lower - m g eps.
+    const Real expected = -0.5 - m * g * eps;
+    const Real pos = pr->getAngle();
+    MESSAGE("slide position " << pos << " expected " << expected << " (deflection " << m * g * eps << " m)");
+    CHECK(std::abs(pos - expected) < 0.02 * m * g * eps);
+    CHECK(std::abs(pr->getRange1D().getCurrentForce() - m * g) < 0.01 * m * g);
+  }
+
+  TEST_CASE("hinge lock acts as a torsion spring K with damping D") {
+    // Lock1D with compliance 1/K: a constant torque T holds the hinge at T/K.
+    const Real h = 1.0 / 60, K = 500.0, T = 25.0;
+    TestWorld w(h, 0.0);
+    auto rotor = w.addBox(Vec3(0.5, 0.1, 0.1), Vec3::Zero(), 10.0);
+    auto hinge = std::make_shared<Hinge>(rotor, nullptr, Vec3::Zero(), Vec3::UnitZ());
+    hinge->getLock1D().setEnable(true);
+    hinge->getLock1D().setCompliance(1.0 / K);
+    hinge->getLock1D().setDamping(0.1);
+    w.sim->add(hinge);
+    for (int i = 0; i < 600; ++i) {
+      rotor->addTorque(Vec3(0, 0, T));
+      w.sim->stepForward();
+    }
+    MESSAGE("angle " << hinge->getAngle() << " expected " << T / K);
+    CHECK(std::abs(hinge->getAngle() - T / K) < 0.01 * T / K);
+  }
+
+  TEST_CASE("distance joint keeps its length; ball joint holds a hanging body") {
+    const Real h = 1.0 / 60;
+    TestWorld w(h, 9.81);
+    auto a = w.addSphere(0.05, Vec3(1, 0, 0), 1.0);
+    auto dj = std::make_shared<DistanceJoint>(a, nullptr, Vec3(1, 0, 0), Vec3(0, 0, 0));
+    w.sim->add(dj);
+    auto b = w.addSphere(0.05, Vec3(3, 0, -0.5), 2.0);
+    auto bj = std::make_shared<BallJoint>(b, nullptr, Vec3(3, 0, 0));
+    w.sim->add(bj);
+    Real worst = 0;
+    for (int i = 0; i < 300; ++i) {
+      w.sim->stepForward();
+      worst = std::max(worst, std::abs(dj->getCurrentLength() - 1.0));
+    }
+    MESSAGE("distance joint worst length error " << worst << " m");
+    // A swinging 1 kg bob with the default compliance 1e-8 m/N and PGS: error well under a millimetre.
+    CHECK(worst < 1e-3);
+    // Ball joint static load: force along +z on the body equals m g (reported on B = world side as -m g).
+    CHECK(std::abs((b->getPosition() - Vec3(3, 0, -0.5)).norm()) < 1e-3);
+    const auto& f = bj->getLastForces();
+    CHECK(std::abs(std::abs(f[2]) - 2.0 * 9.81) < 0.02 * 2.0 * 9.81);
+  }
+
+  TEST_CASE("20-link chain with a 100 kg end mass: worst joint error with PGS is recorded") {
+    // chain20 of SCENES.md at the default 16 iterations, hanging at rest and released from horizontal.
+    auto measure = [](bool horizontal) {
+      TestWorld w(1.0 / 60, 9.81);
+      std::vector<RigidBodyRef> links;
+      std::vector<std::shared_ptr<BallJoint>> joints;
+      const Real len = 0.2;
+      RigidBodyRef prev;
+      Vec3 pivot(0, 0, 5);
+      for (int i = 0; i < 20; ++i) {
+        const Vec3 c = horizontal ? Vec3(pivot.x() + len * (i + 0.5), 0, 5) : Vec3(0, 0, 5 - len * (i + 0.5));
+        auto link = w.addBox(horizontal ? Vec3(0.1, 0.025, 0.025) : Vec3(0.025, 0.025, 0.1), c, 1.0);
+        for (auto& g : link->getGeometries()) g->setEnableCollisions(false);
+        const Vec3 anchor = horizontal ? Vec3(len * i, 0, 5) : Vec3(0, 0, 5 - len * i);
+        auto j = std::make_shared<BallJoint>(link, prev, anchor);
+        w.sim->add(j);
+        joints.push_back(j);
+        prev = link;
+        links.push_back(link);
+      }
+      const Vec3 end = horizontal ? Vec3(len * 20, 0, 5) : Vec3(0, 0, 5 - len * 20);
+      const Vec3 ballPos = horizontal ? Vec3(end.x() + 0.2, 0, 5) : Vec3(0, 0, end.z() - 0.2);
+      auto ball = w.addSphere(0.2, ballPos, 100.0);
+      for (auto& g : ball->getGeometries()) g->setEnableCollisions(false);
+      auto jb = std::make_shared<BallJoint>(ball, prev, end);
+      w.sim->add(jb);
+      joints.push_back(jb);
+      Real worst = 0;
+      for (int s = 0; s < 600; ++s) {
+        w.sim->stepForward();
+        for (auto& j : joints) {
+          const Real e = (j->getFrame(0).p - j->getFrame(1).p).norm();
+          worst = std::max(worst, e);
+        }
+        if (!w.finite()) break;
+      }
+      return std::make_pair(worst, w.finite());
+    };
+    const auto hanging = measure(false);
+    const auto released = measure(true);
+    std::printf("chain20 (100:1) PGS 16 iterations: hanging worst joint error %.3e m, released from horizontal %.3e m\n",
+                hanging.first, released.first);
+    // Recorded, not a pass/fail on accuracy (the DIRECT solver issue improves it); the state must stay finite.
+    CHECK(hanging.second);
+    CHECK(released.second);
+  }
+}

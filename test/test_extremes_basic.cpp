@@ -1,0 +1,128 @@
+// Extreme parameters: the state must stay finite, the energy must not grow, and the bodies stay bounded.
+// "Energy not growing": kinetic + gravitational potential energy never exceeds its initial value by more than
+// 1e-6 J per kg plus 1e-9 relative (round-off); contact springs may store energy while compressed, which only
+// lowers K + U, so K + U <= K0 + U0 holds for a passive contact model.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "test_world.h"
+
+using namespace scree;
+using scree::test::TestWorld;
+using scree::test::mechanicalEnergy;
+
+namespace {
+constexpr Real kG = 9.81;
+
+Real totalEnergy(const std::vector<RigidBodyRef>& bodies) {
+  Real e = 0;
+  for (const auto& b : bodies) e += mechanicalEnergy(*b, kG);
+  return e;
+}
+Real energyTolerance(const std::vector<RigidBodyRef>& bodies, Real e0) {
+  Real m = 0;
+  for (const auto& b : bodies) m += b->getMass();
+  return 1e-6 * m + 1e-9 * std::abs(e0);
+}
+}  // namespace
+
+TEST_SUITE("solver") {
+
+TEST_CASE("a resting box stays finite and passive for Young's modulus 1e3 .. 1e12 N/m") {
+  for (Real E : {1e3, 1e5, 1e7, 1e9, 1e12}) {
+    CAPTURE(E);
+    TestWorld w(1.0 / 60.0, kG);
+    w.contactMaterial->setYoungsModulus(E);
+    w.addGround();
+    auto box = w.addBox(Vec3(0.5, 0.5, 0.5), Vec3(0, 0, 0.5), 1.0);
+    const Real e0 = mechanicalEnergy(*box, kG), tol = energyTolerance({box}, e0);
+    Real worstGain = -1e300;
+    for (int i = 0; i < 120; ++i) {
+      w.sim->stepForward();
+      worstGain = std::max(worstGain, mechanicalEnergy(*box, kG) - e0);
+    }
+    // Depth m g / (4 E): 2.5 mm at E = 1e3; the box must stay on the ground and upright.
+    MESSAGE("E " << E << ": z " << box->getPosition().z() << ", worst energy gain " << worstGain << " J");
+    CHECK(w.finite());
+    CHECK(w.sim->getLastStepReport().ok());
+    CHECK(worstGain <= tol);
+    CHECK(box->getPosition().z() > 0.49);
+    CHECK(box->getPosition().z() < 0.51);
+  }
+}
+
+TEST_CASE("a resting box stays finite and passive for time steps 1e-5 .. 0.1 s") {
+  for (Real h : {1e-5, 1e-4, 1e-3, 1.0 / 60.0, 0.1}) {
+    CAPTURE(h);
+    TestWorld w(h, kG);
+    w.addGround();
+    auto box = w.addBox(Vec3(0.5, 0.5, 0.5), Vec3(0, 0, 0.5), 1.0);
+    const Real e0 = mechanicalEnergy(*box, kG), tol = energyTolerance({box}, e0);
+    Real worstGain = -1e300;
+    const int n = 200;  // short runs: 2 ms at 1e-5, 20 s at 0.1
+    for (int i = 0; i < n; ++i) {
+      w.sim->stepForward();
+      worstGain = std::max(worstGain, mechanicalEnergy(*box, kG) - e0);
+    }
+    MESSAGE("h " << h << ": z " << box->getPosition().z() << ", worst energy gain " << worstGain << " J");
+    CHECK(w.finite());
+    CHECK(worstGain <= tol);
+    CHECK(box->getPosition().z() > 0.45);
+    CHECK(box->getPosition().z() < 0.55);
+  }
+}
+
+TEST_CASE("100 m/s impacts on the ground: finite, no energy gain, the body stays above the ground") {
+  for (bool sphere : {true, false}) {
+    CAPTURE(sphere);
+    TestWorld w(1.0 / 60.0, kG, 0.5, 0.5);
+    w.addGround();
+    auto b = sphere ? w.addSphere(0.1, Vec3(0, 0, 3.0), 1.0) : w.addBox(Vec3(0.2, 0.2, 0.2), Vec3(0, 0, 3.0), 1.0);
+    b->setVelocity(Vec3(0, 0, -100));
+    const Real e0 = mechanicalEnergy(*b, kG), tol = energyTolerance({b}, e0);
+    Real worstGain = -1e300, minZ = 1e300;
+    for (int i = 0; i < 180; ++i) {
+      w.sim->stepForward();
+      worstGain = std::max(worstGain, mechanicalEnergy(*b, kG) - e0);
+      minZ = std::min(minZ, b->getPosition().z());
+    }
+    MESSAGE(std::string(sphere ? "sphere" : "box") << ": lowest centre z " << minZ << ", final z " << b->getPosition().z()
+                                        << ", worst energy gain " << worstGain << " J (E0 " << e0 << ")");
+    CHECK(w.finite());
+    CHECK(worstGain <= tol);
+    CHECK(minZ > 0);  // the centre never goes below the ground's top face
+  }
+}
+
+TEST_CASE("a 1e6 kg box on a 1 kg box: finite and bounded") {
+  TestWorld w(1.0 / 60.0, kG);
+  w.addGround();
+  auto light = w.addBox(Vec3(0.5, 0.5, 0.5), Vec3(0, 0, 0.5), 1.0);
+  auto heavy = w.addBox(Vec3(0.5, 0.5, 0.5), Vec3(0, 0, 1.5), 1e6);
+  const Real e0 = totalEnergy({light, heavy}), tol = energyTolerance({light, heavy}, e0);
+  Real worstGain = -1e300, maxSpeed = 0, maxDist = 0;
+  for (int i = 0; i < 300; ++i) {
+    w.sim->stepForward();
+    worstGain = std::max(worstGain, totalEnergy({light, heavy}) - e0);
+    maxSpeed = std::max({maxSpeed, light->getVelocity().norm(), heavy->getVelocity().norm()});
+    maxDist = std::max({maxDist, (light->getPosition() - Vec3(0, 0, 0.5)).norm(),
+                        (heavy->getPosition() - Vec3(0, 0, 1.5)).norm()});
+  }
+  MESSAGE("1e6 : 1 stack: heavy z " << heavy->getPosition().z() << ", light at "
+                                    << light->getPosition().transpose() << ", max speed " << maxSpeed
+                                    << " m/s, max displacement " << maxDist << " m, worst energy gain " << worstGain
+                                    << " J");
+  CHECK(w.finite());
+  CHECK(w.sim->getLastStepReport().ok());
+  // Bounded: nothing launched (a squeeze-out may move the light box a few metres at most) and the heavy box
+  // ends above the ground.
+  CHECK(maxSpeed < 10.0);
+  CHECK(maxDist < 5.0);
+  CHECK(heavy->getPosition().z() > 0.4);
+  CHECK(worstGain <= tol);
+}
+
+}  // TEST_SUITE
