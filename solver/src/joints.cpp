@@ -61,7 +61,7 @@ Joint::FrameState Joint::state() const {
 }
 
 Vec3 Joint::rotationError(const FrameState& f) {
-  Quat qr = f.qA.conjugate() * f.qB;
+  Quat qr = f.qB.conjugate() * f.qA;
   if (qr.w() < 0) qr.coeffs() = -qr.coeffs();
   const Vec3 v = qr.vec();
   const Real s = v.norm();
@@ -85,10 +85,10 @@ void Joint::finishRow(const ConstraintContext& ctx, ConstraintRow& r, int dof, R
 void Joint::pushLinear(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& dofs, int dof,
                        const FrameState& f, const Vec3& u, Real g, Real compliance, Real damping) const {
   ConstraintRow r;
-  r.jLinA = -u;
-  r.jAngA = -f.rA.cross(u);
-  r.jLinB = u;
-  r.jAngB = f.rB.cross(u);
+  r.jLinA = u;
+  r.jAngA = f.rA.cross(u);
+  r.jLinB = -u;
+  r.jAngB = -f.rB.cross(u);
   finishRow(ctx, r, dof, g, compliance, damping);
   rows.push_back(r);
   dofs.push_back(dof);
@@ -97,11 +97,28 @@ void Joint::pushLinear(const ConstraintContext& ctx, std::vector<ConstraintRow>&
 void Joint::pushAngular(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& dofs, int dof,
                         const Vec3& a, Real g, Real compliance, Real damping) const {
   ConstraintRow r;
-  r.jAngA = -a;
-  r.jAngB = a;
+  r.jAngA = a;
+  r.jAngB = -a;
   finishRow(ctx, r, dof, g, compliance, damping);
   rows.push_back(r);
   dofs.push_back(dof);
+}
+
+void Joint::pushBending(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& dofs,
+                        const FrameState& f, int firstDof) const {
+  // Keep A's axis n_A orthogonal to B's x and y axes p:
+  // d/dt (n_A . p) = (w_A x n_A) . p + n_A . (w_B x p) = w_A . (n_A x p) - w_B . (n_A x p).
+  const Vec3 nA = f.RA.col(2);
+  for (int k = 0; k < 2; ++k) {
+    const Vec3 p = f.RB.col(k);
+    const Vec3 c = nA.cross(p);
+    ConstraintRow r;
+    r.jAngA = c;
+    r.jAngB = -c;
+    finishRow(ctx, r, firstDof + k, nA.dot(p), compliance_[firstDof + k], damping_[firstDof + k]);
+    rows.push_back(r);
+    dofs.push_back(firstDof + k);
+  }
 }
 
 // ---- controllers ---------------------------------------------------------------------------------------------
@@ -232,7 +249,7 @@ BallJoint::BallJoint(RigidBodyRef a, RigidBodyRef b, const Vec3& worldPoint)
 
 void BallJoint::addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) {
   const FrameState f = state();
-  const Vec3 d = f.pB - f.pA;
+  const Vec3 d = f.pA - f.pB;
   for (int k = 0; k < 3; ++k) {
     const Vec3 u = Vec3::Unit(k);
     pushLinear(ctx, rows, outDofs, k, f, u, u.dot(d), compliance_[k], damping_[k]);
@@ -249,42 +266,30 @@ Hinge::Hinge(RigidBodyRef a, RigidBodyRef b, const Vec3& worldPoint, const Vec3&
 
 Real Hinge::getAngle() const {
   const FrameState f = state();
-  // Angle of B's x axis about A's z axis, measured in A's x-y plane; unwrapped against the last value.
-  const Vec3 xb = f.RB.col(0);
-  const Real raw = std::atan2(f.RA.col(1).dot(xb), f.RA.col(0).dot(xb));
+  // Angle of A's x axis about B's z axis, measured in B's x-y plane; unwrapped against the last value.
+  const Vec3 xa = f.RA.col(0);
+  const Real raw = std::atan2(f.RB.col(1).dot(xa), f.RB.col(0).dot(xa));
   lastAngle_ += wrapPi(raw - lastAngle_);
   return lastAngle_;
 }
 
 Real Hinge::getCurrentSpeed() const {
-  const Vec3 n = getFrame(0).q * Vec3::UnitZ();
-  Real w = -n.dot(a_->getAngularVelocity());
-  if (b_) w += n.dot(b_->getAngularVelocity());
+  const Vec3 n = getFrame(1).q * Vec3::UnitZ();
+  Real w = n.dot(a_->getAngularVelocity());
+  if (b_) w -= n.dot(b_->getAngularVelocity());
   return w;
 }
 
 void Hinge::addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) {
   const FrameState f = state();
-  const Vec3 d = f.pB - f.pA;
+  const Vec3 d = f.pA - f.pB;
   for (int k = 0; k < 3; ++k) {
-    const Vec3 u = f.RA.col(k);
+    const Vec3 u = f.RB.col(k);
     pushLinear(ctx, rows, outDofs, k, f, u, u.dot(d), compliance_[k], damping_[k]);
   }
-  // Bending: keep n_B orthogonal to A's x and y axes.
-  const Vec3 nB = f.RB.col(2);
-  for (int k = 0; k < 2; ++k) {
-    const Vec3 p = f.RA.col(k);
-    ConstraintRow r;
-    const Vec3 c = nB.cross(p);
-    // d/dt (n_B . p) = (w_B x n_B) . p + n_B . (w_A x p) = w_B . (n_B x p) - w_A . (n_B x p)
-    r.jAngA = -c;
-    r.jAngB = c;
-    finishRow(ctx, r, ROTATIONAL_1 + k, nB.dot(p), compliance_[ROTATIONAL_1 + k], damping_[ROTATIONAL_1 + k]);
-    rows.push_back(r);
-    outDofs.push_back(ROTATIONAL_1 + k);
-  }
-  const Vec3 n = f.RA.col(2);
-  addControllerRows(ctx, rows, outDofs, MOTOR, Vec3::Zero(), -n, Vec3::Zero(), n, getAngle());
+  pushBending(ctx, rows, outDofs, f, ROTATIONAL_1);
+  const Vec3 n = f.RB.col(2);
+  addControllerRows(ctx, rows, outDofs, MOTOR, Vec3::Zero(), n, Vec3::Zero(), -n, getAngle());
 }
 
 // ---- Prismatic ----------------------------------------------------------------------------------------------
@@ -297,30 +302,30 @@ Prismatic::Prismatic(RigidBodyRef a, RigidBodyRef b, const Vec3& worldPoint, con
 
 Real Prismatic::getAngle() const {
   const FrameState f = state();
-  return f.RA.col(2).dot(f.pB - f.pA);
+  return f.RB.col(2).dot(f.pA - f.pB);
 }
 
 Real Prismatic::getCurrentSpeed() const {
   const FrameState f = state();
-  const Vec3 u = f.RA.col(2);
-  Real v = -u.dot(a_->getVelocityAt(f.pA));
-  if (b_) v += u.dot(b_->getVelocityAt(f.pB));
+  const Vec3 u = f.RB.col(2);
+  Real v = u.dot(a_->getVelocityAt(f.pA));
+  if (b_) v -= u.dot(b_->getVelocityAt(f.pB));
   return v;
 }
 
 void Prismatic::addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) {
   const FrameState f = state();
-  const Vec3 d = f.pB - f.pA;
+  const Vec3 d = f.pA - f.pB;
   for (int k = 0; k < 2; ++k) {
-    const Vec3 u = f.RA.col(k);
+    const Vec3 u = f.RB.col(k);
     pushLinear(ctx, rows, outDofs, k, f, u, u.dot(d), compliance_[k], damping_[k]);
   }
   const Vec3 th = rotationError(f);
   for (int k = 0; k < 3; ++k)
-    pushAngular(ctx, rows, outDofs, ROTATIONAL_1 + k, f.RA.col(k), th[k], compliance_[ROTATIONAL_1 + k],
+    pushAngular(ctx, rows, outDofs, ROTATIONAL_1 + k, f.RB.col(k), th[k], compliance_[ROTATIONAL_1 + k],
                 damping_[ROTATIONAL_1 + k]);
-  const Vec3 u = f.RA.col(2);
-  addControllerRows(ctx, rows, outDofs, MOTOR, -u, -f.rA.cross(u), u, f.rB.cross(u), u.dot(d));
+  const Vec3 u = f.RB.col(2);
+  addControllerRows(ctx, rows, outDofs, MOTOR, u, f.rA.cross(u), -u, -f.rB.cross(u), u.dot(d));
 }
 
 // ---- CylindricalJoint -----------------------------------------------------------------------------------------
@@ -334,38 +339,28 @@ CylindricalJoint::CylindricalJoint(RigidBodyRef a, RigidBodyRef b, const Vec3& w
 
 Real CylindricalJoint::getAngle() const {
   const FrameState f = state();
-  return f.RA.col(2).dot(f.pB - f.pA);
+  return f.RB.col(2).dot(f.pA - f.pB);
 }
 
 Real CylindricalJoint::getCurrentSpeed() const {
   const FrameState f = state();
-  const Vec3 u = f.RA.col(2);
-  Real v = -u.dot(a_->getVelocityAt(f.pA));
-  if (b_) v += u.dot(b_->getVelocityAt(f.pB));
+  const Vec3 u = f.RB.col(2);
+  Real v = u.dot(a_->getVelocityAt(f.pA));
+  if (b_) v -= u.dot(b_->getVelocityAt(f.pB));
   return v;
 }
 
 void CylindricalJoint::addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows,
                                std::vector<int>& outDofs) {
   const FrameState f = state();
-  const Vec3 d = f.pB - f.pA;
+  const Vec3 d = f.pA - f.pB;
   for (int k = 0; k < 2; ++k) {
-    const Vec3 u = f.RA.col(k);
+    const Vec3 u = f.RB.col(k);
     pushLinear(ctx, rows, outDofs, k, f, u, u.dot(d), compliance_[k], damping_[k]);
   }
-  const Vec3 nB = f.RB.col(2);
-  for (int k = 0; k < 2; ++k) {
-    const Vec3 p = f.RA.col(k);
-    ConstraintRow r;
-    const Vec3 c = nB.cross(p);
-    r.jAngA = -c;
-    r.jAngB = c;
-    finishRow(ctx, r, ROTATIONAL_1 + k, nB.dot(p), compliance_[ROTATIONAL_1 + k], damping_[ROTATIONAL_1 + k]);
-    rows.push_back(r);
-    outDofs.push_back(ROTATIONAL_1 + k);
-  }
-  const Vec3 u = f.RA.col(2);
-  addControllerRows(ctx, rows, outDofs, MOTOR, -u, -f.rA.cross(u), u, f.rB.cross(u), u.dot(d));
+  pushBending(ctx, rows, outDofs, f, ROTATIONAL_1);
+  const Vec3 u = f.RB.col(2);
+  addControllerRows(ctx, rows, outDofs, MOTOR, u, f.rA.cross(u), -u, -f.rB.cross(u), u.dot(d));
 }
 
 // ---- DistanceJoint -----------------------------------------------------------------------------------------
@@ -396,7 +391,7 @@ void DistanceJoint::addRows(const ConstraintContext& ctx, std::vector<Constraint
   f.pB = b_ ? b_->getTransform().apply(localB_) : localB_;
   f.rA = f.pA - a_->getCmPosition();
   f.rB = b_ ? Vec3(f.pB - b_->getCmPosition()) : Vec3::Zero();
-  const Vec3 d = f.pB - f.pA;
+  const Vec3 d = f.pA - f.pB;
   const Real len = d.norm();
   if (len < 1e-12) return;  // direction undefined for this step
   const Vec3 u = d / len;
@@ -446,13 +441,13 @@ Real Generic6DofJoint::getDampingCoefficient(int dof) const {
 
 Vec3 Generic6DofJoint::getTranslationError() const {
   const FrameState f = state();
-  return f.RA.transpose() * (f.pB - f.pA);
+  return f.RB.transpose() * (f.pA - f.pB);
 }
 Vec3 Generic6DofJoint::getRotationError() const { return rotationError(state()); }
 
 void Generic6DofJoint::addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) {
   const FrameState f = state();
-  const Vec3 d = f.pB - f.pA;
+  const Vec3 d = f.pA - f.pB;
   const Vec3 th = rotationError(f);
   for (int k = 0; k < NUM_DOFS; ++k) {
     if (modes_[k] == FREE) continue;
@@ -461,10 +456,10 @@ void Generic6DofJoint::addRows(const ConstraintContext& ctx, std::vector<Constra
     const Real eps = modes_[k] == COMPLIANT ? 1.0 / stiffness_[k] : compliance_[k];
     const Real tau = modes_[k] == COMPLIANT ? dampingCoef_[k] / stiffness_[k] : damping_[k];
     if (k < 3) {
-      const Vec3 u = f.RA.col(k);
+      const Vec3 u = f.RB.col(k);
       pushLinear(ctx, rows, outDofs, k, f, u, u.dot(d), eps, tau);
     } else {
-      pushAngular(ctx, rows, outDofs, k, f.RA.col(k - 3), th[k - 3], eps, tau);
+      pushAngular(ctx, rows, outDofs, k, f.RB.col(k - 3), th[k - 3], eps, tau);
     }
   }
 }

@@ -58,6 +58,15 @@ struct Simulation::Impl {
     Real impactSpeed;
   };
   std::vector<PointRows> pointRows;
+  // Row range and solver bodies of each solved contact (for shock propagation).
+  struct ContactRange {
+    int32_t ia, ib;
+    uint32_t begin, count;
+  };
+  std::vector<ContactRange> contactRanges;
+  std::vector<int> level;            // support level per body: 0 static/kinematic, 1 touches those, ...
+  std::vector<std::vector<uint32_t>> adjacency;
+  std::vector<PgsSolver::ShockRange> shock;
   struct ConstraintRange {
     Constraint* c;
     uint32_t begin, count;
@@ -171,7 +180,8 @@ void Simulation::add(ConstraintRef c) {
   detail::requireNonNull("Simulation::add", "constraint", c.get());
   if (std::find(constraints_.begin(), constraints_.end(), c) != constraints_.end()) return;
   constraints_.push_back(c);
-  if (!c->getEnableCollisions()) space_.setEnableCollisions(c->getBodyAt(0), c->getBodyAt(1), false);
+  if (!c->getEnableCollisions() && c->getBodyAt(1))
+    space_.setEnableCollisions(c->getBodyAt(0), c->getBodyAt(1), false);
 }
 
 bool Simulation::remove(const ConstraintRef& c) {
@@ -185,7 +195,7 @@ bool Simulation::remove(const ConstraintRef& c) {
         ((o->getBodyAt(0) == c->getBodyAt(0) && o->getBodyAt(1) == c->getBodyAt(1)) ||
          (o->getBodyAt(0) == c->getBodyAt(1) && o->getBodyAt(1) == c->getBodyAt(0))))
       stillJoined = true;
-  if (!stillJoined) space_.setEnableCollisions(c->getBodyAt(0), c->getBodyAt(1), true);
+  if (!stillJoined && c->getBodyAt(1)) space_.setEnableCollisions(c->getBodyAt(0), c->getBodyAt(1), true);
   return true;
 }
 
@@ -396,6 +406,7 @@ void Simulation::buildRows() {
 
   m.rows.clear();
   m.pointRows.clear();
+  m.contactRanges.clear();
   const Real threshold = solver_.getRestitutionThreshold();
   const Real maxRecovery = solver_.getMaxPenetrationRecoverySpeed();
   const bool warm = solver_.getUseWarmStarting();
@@ -442,6 +453,7 @@ void Simulation::buildRows() {
     int32_t nextFriction = base;
     int32_t nextNormal = base + int32_t(nFriction);
     m.rows.resize(m.rows.size() + nFriction + nActive);
+    m.contactRanges.push_back({ia, ib, uint32_t(base), nFriction + nActive});
     // Weight-based normal impulse estimate for box friction on new contacts: the lighter dynamic body's weight.
     const Real massA = dynA ? 1.0 / m.sb[ia].invMass : 0, massB = dynB ? 1.0 / m.sb[ib].invMass : 0;
     const Real weightImpulse =
@@ -617,6 +629,65 @@ void Simulation::solve() {
   PgsSolver::prepare(m.rows, m.sb);
   solver_.stats().lastResidual = PgsSolver::iterate(m.rows, m.sb, solver_.getNumIterations());
   solver_.stats().numIterations = size_t(solver_.getNumIterations());
+  if (solver_.getUseShockPropagation() && !m.contactRanges.empty()) {
+    buildShockOrder();
+    PgsSolver::shockPass(m.rows, m.sb, m.shock);
+  }
+}
+
+void Simulation::buildShockOrder() {
+  // Support levels by breadth-first search over the contact graph from non-dynamic bodies and body-less
+  // geometries (level 0). Contacts between different levels freeze the lower body in the shock pass and are
+  // visited in increasing lower level; contacts within one level are left to the sweeps.
+  Impl& m = *impl_;
+  const size_t nb = bodies_.size();
+  const int kUnreached = 1 << 30;
+  m.level.assign(nb, kUnreached);
+  if (m.adjacency.size() < nb) m.adjacency.resize(nb);
+  for (size_t i = 0; i < nb; ++i) m.adjacency[i].clear();
+  std::vector<uint32_t> frontier;
+  for (uint32_t k = 0; k < m.contactRanges.size(); ++k) {
+    const auto& c = m.contactRanges[k];
+    if (c.ia >= 0) m.adjacency[c.ia].push_back(k);
+    if (c.ib >= 0) m.adjacency[c.ib].push_back(k);
+  }
+  for (size_t i = 0; i < nb; ++i)
+    if (m.sb[i].invMass == 0) {
+      m.level[i] = 0;
+      frontier.push_back(uint32_t(i));
+    }
+  for (const auto& c : m.contactRanges) {
+    // A dynamic body touching a body-less (static) geometry is at level 1.
+    if (c.ia < 0 && c.ib >= 0 && m.level[c.ib] > 1) { m.level[c.ib] = 1; frontier.push_back(uint32_t(c.ib)); }
+    if (c.ib < 0 && c.ia >= 0 && m.level[c.ia] > 1) { m.level[c.ia] = 1; frontier.push_back(uint32_t(c.ia)); }
+  }
+  // frontier may hold level-0 and level-1 seeds; process in level order.
+  std::stable_sort(frontier.begin(), frontier.end(), [&](uint32_t x, uint32_t y) { return m.level[x] < m.level[y]; });
+  for (size_t head = 0; head < frontier.size(); ++head) {
+    const uint32_t b = frontier[head];
+    for (uint32_t k : m.adjacency[b]) {
+      const auto& c = m.contactRanges[k];
+      const int other = c.ia == int32_t(b) ? c.ib : c.ia;
+      if (other >= 0 && m.level[other] > m.level[b] + 1) {
+        m.level[other] = m.level[b] + 1;
+        frontier.push_back(uint32_t(other));
+      }
+    }
+  }
+  m.shock.clear();
+  std::vector<std::pair<int, uint32_t>> order;
+  for (uint32_t k = 0; k < m.contactRanges.size(); ++k) {
+    const auto& c = m.contactRanges[k];
+    const int la = c.ia >= 0 ? m.level[c.ia] : 0, lb = c.ib >= 0 ? m.level[c.ib] : 0;
+    if (la == lb) continue;
+    order.push_back({std::min(la, lb), k});
+  }
+  std::stable_sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (const auto& [lvl, k] : order) {
+    const auto& c = m.contactRanges[k];
+    const int la = c.ia >= 0 ? m.level[c.ia] : 0, lb = c.ib >= 0 ? m.level[c.ib] : 0;
+    m.shock.push_back({c.begin, c.count, la < lb ? 0 : 1});
+  }
 }
 
 void Simulation::integrate() {

@@ -1,18 +1,19 @@
 // Joints (AGX: agx::BallJoint, Hinge, Prismatic, LockJoint, DistanceJoint, CylindricalJoint) and a generic
 // 6-DOF constraint whose DOFs can each be FREE, LOCKED or COMPLIANT (the tire model is built on it).
 //
-// Frames: a joint is defined by an attachment frame on each body, both coinciding at construction. The
-// frame's z axis is the joint axis (hinge/prismatic/cylindrical). With body B null the second frame is fixed in
-// the world. Rows (SPOOK, spook.h) per DOF:
-//   translational DOF along frame-A axis u:  g = u . (pB - pA),  J = [-u, -(rA x u), u, (rB x u)]
-//   rotational DOF about frame-A axis a:      g = theta_a (rotation vector of qA_frame^-1 qB_frame, small-angle
-//                                                 exact log map), J = [0, -a, 0, a]
-//   hinge/cylindrical bending rows keep the B axis n_B orthogonal to the A frame's x/y axes p:
-//                                             g = n_B . p, J = [0, -(n_B x p), 0, (n_B x p)]
+// Frames: a joint is defined by an attachment frame on each body, both coinciding at construction (so the
+// configuration at construction is the rest state). The frame's z axis is the joint axis (hinge, prismatic,
+// cylindrical). With body B null the second frame is fixed in the world. Every DOF measures body A relative to
+// body B, in B's frame (the world's when B is null): a hinge angle is A's rotation about B's z axis, a
+// prismatic position is A's displacement along it. Rows (SPOOK, spook.h) per DOF:
+//   translational DOF along frame-B axis u:  g = u . (pA - pB),  J = [u, (rA x u), -u, -(rB x u)]
+//   rotational DOF about frame-B axis a:      g = theta_a (log map of qB_frame^-1 qA_frame), J = [0, a, 0, -a]
+//   hinge/cylindrical bending rows keep A's axis n_A orthogonal to B's x/y axes p:
+//                                             g = n_A . p, J = [0, (n_A x p), 0, -(n_A x p)]
 // so a hinge's free angle may grow without bound (no small-angle assumption on it).
 //
-// Forces: getLastForces()[dof] is the force (N) or torque (N m) the row applied to body B along +axis in the
-// last step (body A got the opposite). DOF indices are given by each class's enum.
+// Forces: getLastForces()[dof] is the force (N) or torque (N m) the row applied to body A along +axis in the
+// last step (body B got the opposite). DOF indices are given by each class's enum.
 //
 // Controllers on Hinge, Prismatic and CylindricalJoint (AGX: Motor1D, Range1D, Lock1D), each with its own row:
 //   Motor1D: velocity row, target speed (rad/s or m/s) within a force range (N m or N).
@@ -57,7 +58,10 @@ class Joint : public Constraint {
                    const Vec3& a, Real g, Real compliance, Real damping) const;
   /// Finishes a row whose Jacobian is set: SPOOK holonomic rhs from g (or velocity row when `velocityRow`).
   void finishRow(const ConstraintContext& ctx, ConstraintRow& r, int dof, Real g, Real compliance, Real damping) const;
-  /// Relative rotation vector of frame B in frame A coordinates (log map).
+  /// Bending rows (two DOFs from firstDof) of hinge and cylindrical joints.
+  void pushBending(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& dofs,
+                   const FrameState& f, int firstDof) const;
+  /// Relative rotation vector of frame A in frame B coordinates (log map).
   static Vec3 rotationError(const FrameState& f);
 
   Attachment att_[2];
@@ -207,7 +211,7 @@ class DistanceJoint : public Joint {
   Real length_ = 0;
 };
 
-/// Six DOFs in the attachment frame of A, each FREE, LOCKED or COMPLIANT.
+/// Six DOFs in the attachment frame of B (world when B is null), each FREE, LOCKED or COMPLIANT.
 class Generic6DofJoint : public Joint {
  public:
   enum Dof { TRANSLATIONAL_1 = 0, TRANSLATIONAL_2, TRANSLATIONAL_3, ROTATIONAL_1, ROTATIONAL_2, ROTATIONAL_3, NUM_DOFS };
@@ -221,7 +225,7 @@ class Generic6DofJoint : public Joint {
   void setStiffness(int dof, Real stiffness, Real dampingCoefficient);
   Real getStiffness(int dof) const;
   Real getDampingCoefficient(int dof) const;
-  /// Current deviation of each DOF: translations in frame A (m), rotation vector components (rad).
+  /// Current deviation of each DOF (A relative to B, in B's frame): translations (m), rotation vector (rad).
   Vec3 getTranslationError() const;
   Vec3 getRotationError() const;
   void addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) override;

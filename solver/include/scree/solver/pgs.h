@@ -8,6 +8,7 @@
 // Warm starting: rows arrive with lambda from last step; prepare() applies those impulses first.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "scree/core/math.h"
@@ -30,6 +31,18 @@ class PgsSolver {
   static void prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies);
   /// `iterations` sweeps over all rows in order. Returns the largest |delta lambda| of the last sweep.
   static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations);
+
+  /// A row range whose body `frozen` (0 = A, 1 = B) is held immovable in the shock-propagation pass.
+  struct ShockRange {
+    uint32_t begin, count;
+    int frozen;
+  };
+  /// Shock propagation (Guendelman, Bridson & Fedkiw 2003): one Gauss-Seidel pass over the given row ranges
+  /// (ordered from the ground up), each solved with its lower body treated as infinitely heavy. After the
+  /// sweeps, this removes the residual approach velocity that a stack of N bodies would otherwise need ~N
+  /// sweeps to remove, so supports hold at low iteration counts. Rows of a range are visited normals first.
+  static void shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                        const std::vector<ShockRange>& ranges);
 };
 
 }  // namespace scree

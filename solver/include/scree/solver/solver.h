@@ -32,6 +32,12 @@ class Solver {
   /// already limits the push-out.
   void setMaxPenetrationRecoverySpeed(Real v);
   Real getMaxPenetrationRecoverySpeed() const { return maxRecovery_; }
+  /// Shock propagation after the PGS sweeps (default on): contacts are visited once more from the static
+  /// ground upwards with the supporting (lower) body held immovable, so stacks and heavy-on-light supports hold
+  /// at low iteration counts. It trades exact momentum exchange within that one pass for stacking stability;
+  /// switch it off for the plain PGS result.
+  void setUseShockPropagation(bool on) { shock_ = on; }
+  bool getUseShockPropagation() const { return shock_; }
   const SolverStats& getStats() const { return stats_; }
   SolverStats& stats() { return stats_; }
 
@@ -40,6 +46,7 @@ class Solver {
   bool warm_ = true;
   Real restitutionThreshold_ = 0.2;
   Real maxRecovery_ = 0;
+  bool shock_ = true;
   SolverStats stats_;
 };
 
