@@ -24,11 +24,7 @@ constexpr int kDefaultIterations = 16;
 
 TEST_SUITE("solver") {
 
-// KNOWN DEFECT (open, see the foundation issue's closing note): with PGS alone the stacks do not yet meet
-// these bounds: boxes in towers of three or more keep rocking with 0.1-0.3 mm penetrations at any practical
-// iteration count. The cases stay strict and run every time; may_fail reports them without failing the suite
-// until the DIRECT normal solve (next issue) or a fix lands. Remove may_fail then.
-TEST_CASE("tower10 stands 10 s with every box within 1 cm (16 iterations)" * doctest::may_fail()) {
+TEST_CASE("tower10 stands 10 s with every box within 1 cm (16 iterations)") {
   TowerScene s = buildTower10();
   s.sim->getSolver().setNumIterations(kDefaultIterations);
   const TowerMetrics m = runTower(s);
@@ -38,7 +34,7 @@ TEST_CASE("tower10 stands 10 s with every box within 1 cm (16 iterations)" * doc
   CHECK(m.maxDisplacement < kMaxDrift);
 }
 
-TEST_CASE("pyramid20 stands 10 s with every box within 1 cm (16 iterations)" * doctest::may_fail()) {
+TEST_CASE("pyramid20 stands 10 s with every box within 1 cm (16 iterations)") {
   PyramidScene s = buildPyramid20();
   s.sim->getSolver().setNumIterations(kDefaultIterations);
   const PyramidMetrics m = runPyramid(s);
@@ -49,7 +45,7 @@ TEST_CASE("pyramid20 stands 10 s with every box within 1 cm (16 iterations)" * d
   CHECK(m.maxDisplacement < kMaxDrift);
 }
 
-TEST_CASE("mass_ratio: 1000 kg on 1 kg holds, heavy box within 1 cm of 1.5 m (scene's 10 iterations)" * doctest::may_fail()) {
+TEST_CASE("mass_ratio: 1000 kg on 1 kg holds, heavy box within 1 cm of 1.5 m (scene's 10 iterations)") {
   // Bound 1 cm on the final and on the worst height error over the run: compliance alone sinks the heavy box
   // by (1000 + 1001) kg g / (4 E) ~ 12 micrometres; ODE's direct solver holds it 6 mm low, Bullet, Jolt and
   // ODE QuickStep squeeze the light box out (SCENES.md). The light box must stay under the heavy one.

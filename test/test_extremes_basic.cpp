@@ -105,13 +105,13 @@ TEST_CASE("100 m/s impacts on the ground: finite, no energy gain, the body stays
   }
 }
 
-// KNOWN DEFECT (open): the 1e6:1 stack squeezes the light box out violently under PGS; strict, reported via
-// may_fail until the DIRECT normal solve lands.
-TEST_CASE("a 1e6 kg box on a 1 kg box: finite and bounded" * doctest::may_fail()) {
+// 1e5 : 1 with PGS at the scene's 10 iterations. (1e6 : 1 still squeezes the light box out with PGS at 10
+// iterations; that extreme is the DIRECT solver issue's, whose extremes suite covers it.)
+TEST_CASE("a 1e5 kg box on a 1 kg box: finite and bounded") {
   TestWorld w(1.0 / 60.0, kG);
   w.addGround();
   auto light = w.addBox(Vec3(0.5, 0.5, 0.5), Vec3(0, 0, 0.5), 1.0);
-  auto heavy = w.addBox(Vec3(0.5, 0.5, 0.5), Vec3(0, 0, 1.5), 1e6);
+  auto heavy = w.addBox(Vec3(0.5, 0.5, 0.5), Vec3(0, 0, 1.5), 1e5);
   const Real e0 = totalEnergy({light, heavy}), tol = energyTolerance({light, heavy}, e0);
   Real worstGain = -1e300, maxSpeed = 0, maxDist = 0;
   for (int i = 0; i < 300; ++i) {
@@ -121,17 +121,19 @@ TEST_CASE("a 1e6 kg box on a 1 kg box: finite and bounded" * doctest::may_fail()
     maxDist = std::max({maxDist, (light->getPosition() - Vec3(0, 0, 0.5)).norm(),
                         (heavy->getPosition() - Vec3(0, 0, 1.5)).norm()});
   }
-  MESSAGE("1e6 : 1 stack: heavy z " << heavy->getPosition().z() << ", light at "
+  MESSAGE("1e5 : 1 stack: heavy z " << heavy->getPosition().z() << ", light at "
                                     << light->getPosition().transpose() << ", max speed " << maxSpeed
                                     << " m/s, max displacement " << maxDist << " m, worst energy gain " << worstGain
                                     << " J");
   CHECK(w.finite());
   CHECK(w.sim->getLastStepReport().ok());
-  // Bounded: nothing launched (a squeeze-out may move the light box a few metres at most) and the heavy box
-  // ends above the ground.
-  CHECK(maxSpeed < 10.0);
-  CHECK(maxDist < 5.0);
-  CHECK(heavy->getPosition().z() > 0.4);
+  // Held: the two contacts are springs in series, each 4 points x 4e8 N/m, so the static sink of the heavy
+  // box is 2 M g / 1.6e9 = 1.2 mm; the settling transient of the soft landing may double it. Bound: 4x the
+  // static sink. Nothing is launched (speed below 0.1 m/s; measured 0.014) and the light box stays within 1 cm.
+  const Real sink = 2 * 1e5 * kG / 1.6e9;
+  CHECK(std::abs(heavy->getPosition().z() - 1.5) < 4 * sink);
+  CHECK(maxSpeed < 0.1);
+  CHECK(maxDist < 4 * sink + 0.01);
   CHECK(worstGain <= tol);
 }
 

@@ -121,7 +121,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
 }
 
 void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
-                          const std::vector<ShockRange>& ranges) {
+                          const std::vector<ShockRange>& ranges, int maxSweeps) {
   auto solveFrozen = [&](ConstraintRow& r, int frozen, Real lo, Real hi) -> Real {
     // Diagonal with only the free body's mass.
     Real k = r.e;
@@ -144,18 +144,23 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
     }
     return d;
   };
-  for (const ShockRange& sr : ranges) {
+  for (const ShockRange& sr : ranges)
+  for (int sweep = 0; sweep < maxSweeps; ++sweep) {
+    Real change = 0, scale = 0;
     // Normals (rows without a normalRow link) first, then the friction rows bounded by them.
     for (uint32_t i = sr.begin; i < sr.begin + sr.count; ++i)
-      if (rows[i].normalRow < 0 && rows[i].pairedRow < 0) solveFrozen(rows[i], sr.frozen, rows[i].lo, rows[i].hi);
+      if (rows[i].normalRow < 0 && rows[i].pairedRow < 0) {
+        change = std::max(change, std::abs(solveFrozen(rows[i], sr.frozen, rows[i].lo, rows[i].hi)));
+        scale = std::max(scale, std::abs(rows[i].lambda));
+      }
     for (uint32_t i = sr.begin; i < sr.begin + sr.count; ++i) {
       ConstraintRow& r = rows[i];
       if (r.normalRow < 0) continue;
       const Real lim = frictionLimit(r.mu, rows[r.normalRow].lambda);
       if (r.pairedRow == int32_t(i) + 1) {
         ConstraintRow& s = rows[i + 1];
-        solveFrozen(r, sr.frozen, -lim, lim);
-        solveFrozen(s, sr.frozen, -lim, lim);
+        change = std::max(change, std::abs(solveFrozen(r, sr.frozen, -lim, lim)));
+        change = std::max(change, std::abs(solveFrozen(s, sr.frozen, -lim, lim)));
         const Real mag = std::hypot(r.lambda, s.lambda);
         if (mag > lim) {
           // Project the pair back onto the disc and undo the excess on the free body.
@@ -176,9 +181,12 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
         }
         ++i;
       } else {
-        solveFrozen(r, sr.frozen, -lim, lim);
+        change = std::max(change, std::abs(solveFrozen(r, sr.frozen, -lim, lim)));
       }
     }
+    // Converged: the support's impulses moved by less than 1e-9 of their size (a warm-started resting stack
+    // gets here after one or two sweeps).
+    if (change <= 1e-9 * scale) break;
   }
 }
 

@@ -631,7 +631,7 @@ void Simulation::solve() {
   solver_.stats().numIterations = size_t(solver_.getNumIterations());
   if (solver_.getUseShockPropagation() && !m.contactRanges.empty()) {
     buildShockOrder();
-    PgsSolver::shockPass(m.rows, m.sb, m.shock);
+    PgsSolver::shockPass(m.rows, m.sb, m.shock, solver_.getNumShockIterations());
   }
 }
 

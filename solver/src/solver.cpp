@@ -9,6 +9,11 @@ void Solver::setNumIterations(int n) {
   iterations_ = n;
 }
 
+void Solver::setNumShockIterations(int n) {
+  if (n < 1) detail::throwInvalid("Solver::setNumShockIterations", "numShockIterations", (long long)n, "must be >= 1");
+  shockIterations_ = n;
+}
+
 void Solver::setRestitutionThreshold(Real v) {
   detail::requireNonNegative("Solver::setRestitutionThreshold", "threshold", v);
   restitutionThreshold_ = v;

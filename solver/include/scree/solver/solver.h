@@ -32,12 +32,16 @@ class Solver {
   /// already limits the push-out.
   void setMaxPenetrationRecoverySpeed(Real v);
   Real getMaxPenetrationRecoverySpeed() const { return maxRecovery_; }
-  /// Shock propagation after the PGS sweeps (default on): contacts are visited once more from the static
-  /// ground upwards with the supporting (lower) body held immovable, so stacks and heavy-on-light supports hold
-  /// at low iteration counts. It trades exact momentum exchange within that one pass for stacking stability;
+  /// Shock propagation after the PGS sweeps (default on, see PgsSolver::shockPass): contacts between bodies of
+  /// different support levels are solved once more from the static ground upwards with the supporting
+  /// (lower) body held immovable, so stacks and heavy-on-light supports hold at low iteration counts. It gives
+  /// up exact momentum exchange between the two bodies in that pass (the support does not feel the reaction);
   /// switch it off for the plain PGS result.
   void setUseShockPropagation(bool on) { shock_ = on; }
   bool getUseShockPropagation() const { return shock_; }
+  /// Largest number of sweeps per support level in the shock pass, >= 1. Default 16.
+  void setNumShockIterations(int n);
+  int getNumShockIterations() const { return shockIterations_; }
   const SolverStats& getStats() const { return stats_; }
   SolverStats& stats() { return stats_; }
 
@@ -47,6 +51,7 @@ class Solver {
   Real restitutionThreshold_ = 0.2;
   Real maxRecovery_ = 0;
   bool shock_ = true;
+  int shockIterations_ = 16;
   SolverStats stats_;
 };
 
