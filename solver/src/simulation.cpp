@@ -58,10 +58,11 @@ struct Simulation::Impl {
     Real impactSpeed;
   };
   std::vector<PointRows> pointRows;
-  // Row range and solver bodies of each solved contact (for shock propagation).
+  // Row range and solver bodies of each solved contact and constraint (for shock propagation).
   struct ContactRange {
     int32_t ia, ib;
     uint32_t begin, count;
+    bool joint;
   };
   std::vector<ContactRange> contactRanges;
   std::vector<int> level;            // support level per body: 0 static/kinematic, 1 touches those, ...
@@ -453,7 +454,7 @@ void Simulation::buildRows() {
     int32_t nextFriction = base;
     int32_t nextNormal = base + int32_t(nFriction);
     m.rows.resize(m.rows.size() + nFriction + nActive);
-    m.contactRanges.push_back({ia, ib, uint32_t(base), nFriction + nActive});
+    m.contactRanges.push_back({ia, ib, uint32_t(base), nFriction + nActive, false});
     // Weight-based normal impulse estimate for box friction on new contacts: the lighter dynamic body's weight.
     const Real massA = dynA ? 1.0 / m.sb[ia].invMass : 0, massB = dynB ? 1.0 / m.sb[ib].invMass : 0;
     const Real weightImpulse =
@@ -601,6 +602,8 @@ void Simulation::buildRows() {
     c->addRows(ctx, m.rows, m.rowDofs);
     if (c->getSolveType() != FrictionModel::ITERATIVE) nonIterative = true;
     m.ranges.push_back({c.get(), begin, uint32_t(m.rows.size() - begin)});
+    // Joints couple bodies for support levels too (a chain hanging from the world is supported link by link).
+    m.contactRanges.push_back({ctx.indexA, ctx.indexB, begin, uint32_t(m.rows.size() - begin), true});
   }
   if (nonIterative && !m.warnedSolveType) {
     m.warnedSolveType = true;
@@ -636,9 +639,10 @@ void Simulation::solve() {
 }
 
 void Simulation::buildShockOrder() {
-  // Support levels by breadth-first search over the contact graph from non-dynamic bodies and body-less
-  // geometries (level 0). Contacts between different levels freeze the lower body in the shock pass and are
-  // visited in increasing lower level; contacts within one level are left to the sweeps.
+  // Support levels by breadth-first search over the graph of contacts and constraints from non-dynamic bodies,
+  // body-less geometries and the world (level 0). Couplings between different levels freeze the lower body in
+  // the shock pass and are visited in increasing lower level; couplings within one level are left to the
+  // sweeps.
   Impl& m = *impl_;
   const size_t nb = bodies_.size();
   const int kUnreached = 1 << 30;
@@ -657,7 +661,7 @@ void Simulation::buildShockOrder() {
       frontier.push_back(uint32_t(i));
     }
   for (const auto& c : m.contactRanges) {
-    // A dynamic body touching a body-less (static) geometry is at level 1.
+    // A dynamic body touching a body-less (static) geometry, or jointed to the world, is at level 1.
     if (c.ia < 0 && c.ib >= 0 && m.level[c.ib] > 1) { m.level[c.ib] = 1; frontier.push_back(uint32_t(c.ib)); }
     if (c.ib < 0 && c.ia >= 0 && m.level[c.ia] > 1) { m.level[c.ia] = 1; frontier.push_back(uint32_t(c.ia)); }
   }
@@ -680,6 +684,13 @@ void Simulation::buildShockOrder() {
     const auto& c = m.contactRanges[k];
     const int la = c.ia >= 0 ? m.level[c.ia] : 0, lb = c.ib >= 0 ? m.level[c.ib] : 0;
     if (la == lb) continue;
+    if (c.joint && c.ia >= 0 && c.ib >= 0) {
+      // A joint only propagates support from a body at least as heavy as the one it holds: freezing a light
+      // link under a heavy load would force the light link's velocity error onto the load.
+      const Real invLow = la < lb ? m.sb[c.ia].invMass : m.sb[c.ib].invMass;
+      const Real invHigh = la < lb ? m.sb[c.ib].invMass : m.sb[c.ia].invMass;
+      if (invLow > invHigh) continue;
+    }
     order.push_back({std::min(la, lb), k});
   }
   std::stable_sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
