@@ -20,4 +20,5 @@
 #include "scree/solver/simulation.h"
 #include "scree/solver/solver.h"
 #include "scree/solver/spook.h"
+#include "scree/model/model.h"
 #include "scree/version.h"

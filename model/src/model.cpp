@@ -1,2 +1,6 @@
 // Model layer (terrain, tire, granular fields, suction): later issues.
-namespace scree::detail { int modelLayerVersion() { return 0; } }
+#include "scree/model/model.h"
+
+namespace scree::detail {
+int modelLayerVersion() { return 0; }
+}  // namespace scree::detail
