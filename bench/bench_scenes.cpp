@@ -53,6 +53,21 @@ class MassRatio : public SceneFixture<MassRatioScene> {
 BENCHMARK_DEFINE_F(MassRatio, mass_ratio)(benchmark::State& state) { run(state); }
 BENCHMARK_REGISTER_F(MassRatio, mass_ratio)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// ---- chain20 ------------------------------------------------------------------------------------------------
+class Chain20 : public SceneFixture<Chain20Scene> {
+ protected:
+  Chain20Scene build() override { return buildChain20(); }
+  void measure(benchmark::State& state, Chain20Scene& s) override {
+    const ChainMetrics m = runChain20(s);
+    state.counters["sep_max_m"] = m.maxSeparation;
+    state.counters["sep_mean_m"] = m.meanSeparation;
+    state.counters["sep_final_m"] = m.finalSeparation;
+    state.counters["t_above_10cm_s"] = m.firstAbove10cm;
+  }
+};
+BENCHMARK_DEFINE_F(Chain20, chain20)(benchmark::State& state) { run(state); }
+BENCHMARK_REGISTER_F(Chain20, chain20)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 // ---- slide --------------------------------------------------------------------------------------------------
 class Slide : public SceneFixture<SlideScene> {
  protected:

@@ -10,8 +10,6 @@
 // number of steps and returns the metrics; the observers can be fed step by step by callers that step the
 // simulation themselves (benchmarks, examples).
 //
-// TODO(joints issue): chain20 (SCENES.md §7) — builder and metrics (largest / mean / final joint separation,
-// time of first separation above 0.1 m) once BallJoint is available.
 #pragma once
 
 #include <cstddef>
@@ -274,5 +272,37 @@ OverheadMetrics runOverhead(OverheadScene& s);
 bool allFinite(const Simulation& sim);
 /// The 8 world-space corners of a box body with half extents he.
 std::vector<Vec3> boxCorners(const RigidBody& body, const Vec3& halfExtents);
+
+// 7. chain20: pivot at (0, 0, 5), 20 box links (0.2 x 0.05 x 0.05 m, 1 kg) laid along +x and joined end to end
+// by ball joints, a 100 kg sphere (r = 0.2) on a ball joint 0.2 m beyond the last link; collisions off;
+// released from rest; dt 1/60, 600 steps. `hanging` builds the same chain hanging straight down at rest
+// (a static-load check; not part of SCENES.md).
+struct Chain20Scene : Scene {
+  std::vector<RigidBodyRef> links;
+  RigidBodyRef ball;
+  std::vector<std::shared_ptr<BallJoint>> joints;  ///< pivot first, ball joint last
+};
+Chain20Scene buildChain20(Real ballMass = 100.0, bool hanging = false);
+
+struct ChainMetrics {
+  Real maxSeparation = 0;     ///< m, largest anchor separation over all joints and steps
+  Real meanSeparation = 0;    ///< m, mean over joints and steps
+  Real finalSeparation = 0;   ///< m, largest over joints at the last step
+  Real firstAbove10cm = -1;   ///< s, first time any joint separates by more than 0.1 m (-1: never)
+  bool finite = true;
+};
+class ChainObserver {
+ public:
+  explicit ChainObserver(const Chain20Scene& s) : s_(s) {}
+  void observe();
+  ChainMetrics result() const;
+
+ private:
+  const Chain20Scene& s_;
+  ChainMetrics m_;
+  Real sum_ = 0;
+  size_t count_ = 0;
+};
+ChainMetrics runChain20(Chain20Scene& s);
 
 }  // namespace scree::scenes
