@@ -1,6 +1,7 @@
 // Umbrella header: everything a Scree user needs.
 #pragma once
 
+#include "scree/core/assert.h"
 #include "scree/core/contact.h"
 #include "scree/core/errors.h"
 #include "scree/core/listeners.h"

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "scree/core/assert.h"
+
 namespace scree {
 
 namespace {
@@ -36,6 +38,8 @@ inline void applyImpulse(const ConstraintRow& r, Real d, std::vector<SolverBodyS
 
 void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies) {
   for (ConstraintRow& r : rows) {
+    SCREE_ASSERT(r.bodyA < int32_t(bodies.size()) && r.bodyB < int32_t(bodies.size()));
+    SCREE_VALIDATE_CHECK(r.jLinA.allFinite() && r.jAngA.allFinite() && r.jLinB.allFinite() && r.jAngB.allFinite());
     const SolverBodyState& A = r.bodyA >= 0 ? bodies[r.bodyA] : kStatic;
     const SolverBodyState& B = r.bodyB >= 0 ? bodies[r.bodyB] : kStatic;
     r.mJLinA = A.invMass * r.jLinA;
