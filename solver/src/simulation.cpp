@@ -68,6 +68,8 @@ struct Simulation::Impl {
   std::vector<int> level;            // support level per body: 0 static/kinematic, 1 touches those, ...
   std::vector<std::vector<uint32_t>> adjacency;
   std::vector<PgsSolver::ShockRange> shock;
+  std::vector<uint32_t> frontier;                 // scratch of buildShockOrder
+  std::vector<std::pair<int, uint32_t>> order;    // scratch of buildShockOrder
   struct ConstraintRange {
     Constraint* c;
     uint32_t begin, count;
@@ -649,7 +651,8 @@ void Simulation::buildShockOrder() {
   m.level.assign(nb, kUnreached);
   if (m.adjacency.size() < nb) m.adjacency.resize(nb);
   for (size_t i = 0; i < nb; ++i) m.adjacency[i].clear();
-  std::vector<uint32_t> frontier;
+  auto& frontier = m.frontier;
+  frontier.clear();
   for (uint32_t k = 0; k < m.contactRanges.size(); ++k) {
     const auto& c = m.contactRanges[k];
     if (c.ia >= 0) m.adjacency[c.ia].push_back(k);
@@ -679,7 +682,8 @@ void Simulation::buildShockOrder() {
     }
   }
   m.shock.clear();
-  std::vector<std::pair<int, uint32_t>> order;
+  auto& order = m.order;
+  order.clear();
   for (uint32_t k = 0; k < m.contactRanges.size(); ++k) {
     const auto& c = m.contactRanges[k];
     const int la = c.ia >= 0 ? m.level[c.ia] : 0, lb = c.ib >= 0 ? m.level[c.ib] : 0;
