@@ -248,3 +248,41 @@ TEST_SUITE("friction and contact models") {
     CHECK(box->getPosition().z() == doctest::Approx(0.5).epsilon(1e-4));
   }
 }
+
+TEST_SUITE("constraint collisions and filters") {
+  TEST_CASE("two bodies joined by a constraint do not collide unless enabled") {
+    auto run = [](bool enableCollisions) {
+      TestWorld w(1.0 / 60, 0.0);
+      // Two overlapping boxes held together by a hinge: colliding, they would be pushed apart.
+      auto a = w.addBox(Vec3(0.5, 0.5, 0.5), Vec3(0, 0, 0), 1.0);
+      auto b = w.addBox(Vec3(0.5, 0.5, 0.5), Vec3(0.6, 0, 0), 1.0);
+      auto hinge = std::make_shared<Hinge>(a, b, Vec3(0.3, 0, 0), Vec3::UnitZ());
+      hinge->setEnableCollisions(enableCollisions);
+      w.sim->add(hinge);
+      w.steps(10);
+      return w.sim->getContacts().size();
+    };
+    CHECK(run(false) == 0);
+    CHECK(run(true) == 1);
+  }
+
+  TEST_CASE("a property filter selects pairs by a geometry property") {
+    struct Counter : ContactEventListener {
+      int n = 0;
+      KeepContactPolicy impact(const TimeStamp&, GeometryContact&) override {
+        ++n;
+        return KEEP_CONTACT;
+      }
+    };
+    TestWorld w(1.0 / 60, 9.81);
+    w.addGround();
+    auto tagged = w.addSphere(0.1, Vec3(0, 0, 0.2), 1.0);
+    tagged->getGeometries().front()->getPropertyContainer().addPropertyBool("Tracked", true);
+    w.addSphere(0.1, Vec3(2, 0, 0.2), 1.0);
+    auto counter = std::make_shared<Counter>();
+    counter->setFilter(std::make_shared<PropertyFilter>("Tracked"));
+    w.sim->add(counter);
+    w.stepSeconds(1.0);
+    CHECK(counter->n == 1);
+  }
+}

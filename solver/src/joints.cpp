@@ -17,6 +17,12 @@ Vec3 checkedAxis(const char* where, const Vec3& axis) {
   return axis.normalized();
 }
 Real wrapPi(Real a) { return std::remainder(a, 2 * M_PI); }
+// A [lower, upper] interval whose ends may be infinite on their own side.
+void checkInterval(const char* where, Real lower, Real upper) {
+  if (std::isnan(lower) || lower == INFINITY) detail::throwInvalid(where, "lower", lower, "must be < +inf");
+  if (std::isnan(upper) || upper == -INFINITY) detail::throwInvalid(where, "upper", upper, "must be > -inf");
+  if (lower > upper) detail::throwInvalid(where, "lower", lower, "must be <= upper");
+}
 }  // namespace
 
 // ---- Joint --------------------------------------------------------------------------------------------------
@@ -58,6 +64,19 @@ Joint::FrameState Joint::state() const {
   f.rA = f.pA - a_->getCmPosition();
   f.rB = b_ ? Vec3(f.pB - b_->getCmPosition()) : Vec3::Zero();
   return f;
+}
+
+Real Joint::slidePosition() const {
+  const FrameState f = state();
+  return f.RB.col(2).dot(f.pA - f.pB);
+}
+
+Real Joint::slideSpeed() const {
+  const FrameState f = state();
+  const Vec3 u = f.RB.col(2);
+  Real v = u.dot(a_->getVelocityAt(f.pA));
+  if (b_) v -= u.dot(b_->getVelocityAt(f.pB));
+  return v;
 }
 
 Vec3 Joint::rotationError(const FrameState& f) {
@@ -128,9 +147,7 @@ void Motor1D::setSpeed(Real v) {
   speed_ = v;
 }
 void Motor1D::setForceRange(Real lower, Real upper) {
-  if (std::isnan(lower) || lower == INFINITY) detail::throwInvalid("Motor1D::setForceRange", "lower", lower, "must be < +inf");
-  if (std::isnan(upper) || upper == -INFINITY) detail::throwInvalid("Motor1D::setForceRange", "upper", upper, "must be > -inf");
-  if (lower > upper) detail::throwInvalid("Motor1D::setForceRange", "lower", lower, "must be <= upper");
+  checkInterval("Motor1D::setForceRange", lower, upper);
   lo_ = lower;
   hi_ = upper;
 }
@@ -139,9 +156,7 @@ void Motor1D::setCompliance(Real c) {
   compliance_ = c;
 }
 void Range1D::setRange(Real lower, Real upper) {
-  if (std::isnan(lower) || lower == INFINITY) detail::throwInvalid("Range1D::setRange", "lower", lower, "must be < +inf");
-  if (std::isnan(upper) || upper == -INFINITY) detail::throwInvalid("Range1D::setRange", "upper", upper, "must be > -inf");
-  if (lower > upper) detail::throwInvalid("Range1D::setRange", "lower", lower, "must be <= upper");
+  checkInterval("Range1D::setRange", lower, upper);
   lo_ = lower;
   hi_ = upper;
 }
@@ -300,18 +315,8 @@ Prismatic::Prismatic(RigidBodyRef a, RigidBodyRef b, const Vec3& worldPoint, con
   controllerDof_ = MOTOR;
 }
 
-Real Prismatic::getAngle() const {
-  const FrameState f = state();
-  return f.RB.col(2).dot(f.pA - f.pB);
-}
-
-Real Prismatic::getCurrentSpeed() const {
-  const FrameState f = state();
-  const Vec3 u = f.RB.col(2);
-  Real v = u.dot(a_->getVelocityAt(f.pA));
-  if (b_) v -= u.dot(b_->getVelocityAt(f.pB));
-  return v;
-}
+Real Prismatic::getAngle() const { return slidePosition(); }
+Real Prismatic::getCurrentSpeed() const { return slideSpeed(); }
 
 void Prismatic::addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) {
   const FrameState f = state();
@@ -337,18 +342,8 @@ CylindricalJoint::CylindricalJoint(RigidBodyRef a, RigidBodyRef b, const Vec3& w
   controllerDof_ = MOTOR;
 }
 
-Real CylindricalJoint::getAngle() const {
-  const FrameState f = state();
-  return f.RB.col(2).dot(f.pA - f.pB);
-}
-
-Real CylindricalJoint::getCurrentSpeed() const {
-  const FrameState f = state();
-  const Vec3 u = f.RB.col(2);
-  Real v = u.dot(a_->getVelocityAt(f.pA));
-  if (b_) v -= u.dot(b_->getVelocityAt(f.pB));
-  return v;
-}
+Real CylindricalJoint::getAngle() const { return slidePosition(); }
+Real CylindricalJoint::getCurrentSpeed() const { return slideSpeed(); }
 
 void CylindricalJoint::addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows,
                                std::vector<int>& outDofs) {

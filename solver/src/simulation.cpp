@@ -202,32 +202,31 @@ bool Simulation::remove(const ConstraintRef& c) {
   return true;
 }
 
-void Simulation::add(StepEventListenerRef l) {
-  detail::requireNonNull("Simulation::add", "stepEventListener", l.get());
-  if (std::find(stepListeners_.begin(), stepListeners_.end(), l) != stepListeners_.end()) return;
-  l->setSimulation(this);
-  stepListeners_.push_back(std::move(l));
+namespace {
+// Listener lists: add once (the listener learns its simulation), remove (it forgets it).
+template <class Ref>
+void addListener(std::vector<Ref>& list, Ref l, Simulation* sim, const char* param) {
+  detail::requireNonNull("Simulation::add", param, l.get());
+  if (std::find(list.begin(), list.end(), l) != list.end()) return;
+  l->setSimulation(sim);
+  list.push_back(std::move(l));
 }
-bool Simulation::remove(const StepEventListenerRef& l) {
-  auto it = std::find(stepListeners_.begin(), stepListeners_.end(), l);
-  if (it == stepListeners_.end()) return false;
+template <class Ref>
+bool removeListener(std::vector<Ref>& list, const Ref& l) {
+  auto it = std::find(list.begin(), list.end(), l);
+  if (it == list.end()) return false;
   (*it)->setSimulation(nullptr);
-  stepListeners_.erase(it);
+  list.erase(it);
   return true;
 }
+}  // namespace
+
+void Simulation::add(StepEventListenerRef l) { addListener(stepListeners_, std::move(l), this, "stepEventListener"); }
+bool Simulation::remove(const StepEventListenerRef& l) { return removeListener(stepListeners_, l); }
 void Simulation::add(ContactEventListenerRef l) {
-  detail::requireNonNull("Simulation::add", "contactEventListener", l.get());
-  if (std::find(contactListeners_.begin(), contactListeners_.end(), l) != contactListeners_.end()) return;
-  l->setSimulation(this);
-  contactListeners_.push_back(std::move(l));
+  addListener(contactListeners_, std::move(l), this, "contactEventListener");
 }
-bool Simulation::remove(const ContactEventListenerRef& l) {
-  auto it = std::find(contactListeners_.begin(), contactListeners_.end(), l);
-  if (it == contactListeners_.end()) return false;
-  (*it)->setSimulation(nullptr);
-  contactListeners_.erase(it);
-  return true;
-}
+bool Simulation::remove(const ContactEventListenerRef& l) { return removeListener(contactListeners_, l); }
 
 void Simulation::setTimeStep(Real h) {
   detail::requirePositive("Simulation::setTimeStep", "timeStep", h);

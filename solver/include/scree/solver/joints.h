@@ -61,6 +61,9 @@ class Joint : public Constraint {
   /// Bending rows (two DOFs from firstDof) of hinge and cylindrical joints.
   void pushBending(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& dofs,
                    const FrameState& f, int firstDof) const;
+  /// Displacement of A along B's z axis (m) and its rate (m/s): the free DOF of slider joints.
+  Real slidePosition() const;
+  Real slideSpeed() const;
   /// Relative rotation vector of frame A in frame B coordinates (log map).
   static Vec3 rotationError(const FrameState& f);
 
