@@ -470,15 +470,20 @@ void Simulation::buildRows() {
       const Impl::CacheEntry* ce = warm ? m.find(pair, p.featureId) : nullptr;
       if (ce) ++numWarm;
 
+      // Row along direction d through the contact point: J = [d, ra x d, -d, -(rb x d)].
+      auto pointRow = [&](ConstraintRow& row, const Vec3& d) {
+        row = ConstraintRow{};
+        row.bodyA = ia;
+        row.bodyB = ib;
+        row.jLinA = d;
+        row.jAngA = ra.cross(d);
+        row.jLinB = -d;
+        row.jAngB = -rb.cross(d);
+      };
+
       // --- normal row ---
       ConstraintRow& r = m.rows[nextNormal];
-      r = ConstraintRow{};
-      r.bodyA = ia;
-      r.bodyB = ib;
-      r.jLinA = n;
-      r.jAngA = ra.cross(n);
-      r.jLinB = -n;
-      r.jAngB = -rb.cross(n);
+      pointRow(r, n);
       r.solveType = fm ? fm->getSolveType() : FrictionModel::ITERATIVE;
       const Real vn0 = r.jLinA.dot(va0) + r.jAngA.dot(wa0) + r.jLinB.dot(vb0) + r.jAngB.dot(wb0);
       Real impactSpeed = 0;
@@ -536,13 +541,7 @@ void Simulation::buildRows() {
         for (int k = 0; k < 2; ++k) {
           const Vec3& t = k == 0 ? t1 : t2;
           ConstraintRow& f = m.rows[nextFriction + k];
-          f = ConstraintRow{};
-          f.bodyA = ia;
-          f.bodyB = ib;
-          f.jLinA = t;
-          f.jAngA = ra.cross(t);
-          f.jLinB = -t;
-          f.jAngB = -rb.cross(t);
+          pointRow(f, t);
           f.rhs = p.surfaceVelocity.dot(t);
           f.e = eVisc;
           f.mu = mu;
