@@ -13,15 +13,20 @@
 // owns a shared edge or vertex so it is reported once. Feature id = triangle * 8 + region (0 face, 1..3 edges,
 // 4..6 vertices); the capsule uses triangle * 8 + site (0, 1 end spheres, 2 the segment's closest point).
 //
-// Box and convex: (a) shape vertices below (or within the margin above) the triangle under them, with the triangle
-// normal (id = triangle * 8 + vertex index mod 8); (b) sharp height-field vertices (peaks and ridge points: all
-// grid neighbours on or below the plane through the vertex, at least one strictly) inside the shape, pushed out
-// through the least-penetrated downward-facing shape face (id = 0x80000000 | vertex index). Known gap: a
-// height-field ridge edge crossing a shape edge between grid vertices is not seen until a vertex reaches the
-// other shape (a full triangle-vs-polytope SAT needs the Gauss-map limits of each edge to avoid internal-edge
-// normals, left for later).
-// Cylinder: as (a)/(b) with rim points as vertices (4 fixed points per cap when nearly upright, else each cap's
-// deepest rim point along the height field's -z) and caps + side as faces.
+// Box, convex and cylinder: exact SAT per triangle under the shape's footprint (height-field frame): the triangle
+// normal (+n only: solid below), the shape's face normals, and triangle edge x shape edge directions. Internal
+// edges: an axis other than the triangle normal is only accepted as the contact normal when it lies in the normal
+// cone of the triangle feature supporting it (validNormal: every neighbouring grid vertex on or below the plane
+// through that face, edge or vertex), so a flat or concave join only ever gives the face normal and a convex
+// ridge gives normals between its two faces; any axis still counts for separation. Ties prefer the triangle
+// normal, then shape faces, then edges (5% + 1e-7 hysteresis as in convex_convex.cpp). Points: triangle normal ->
+// the shape face most anti-parallel to it clipped by the triangle (crossings of a flat internal join dropped: the
+// neighbour continues the region); shape face -> the triangle clipped by that face; edge axis -> midpoint of the
+// closest points of the two edges. Points of all triangles are merged (first, i.e. lowest triangle, wins a
+// duplicate position) and reduced; id = triangle * 8 + local (a 3-bit hash of face and clip label, 7 for edges).
+// The cylinder is a 16-gon prism rebuilt per triangle with a rim vertex at its deepest point along -n, so face
+// contacts (lowest generator, cap rim) are exact; only rim vertices of a cap become points (no clip crossings).
+// Edge/vertex contacts with the curved side are approximate (inside by at most r (1 - cos(pi / 16))).
 // All pairs reduce to at most 4 points, deepest first.
 #include <algorithm>
 #include <cmath>
@@ -184,83 +189,317 @@ bool footprint(const Shape& s, const Transform& rel, const Grid& g, Real margin,
   return g.cellRange(box.lo, box.hi, i0, i1, j0, j1);
 }
 
-// --- vertex-based contacts for box / convex / cylinder ----------------------------------------------------------
+// --- exact per-triangle SAT for box / convex / cylinder ---------------------------------------------------------
 
-/// (a) shape vertices under the surface.
-void verticesBelow(const Grid& g, const std::vector<Vec3>& verts, Real margin, std::vector<ContactPoint>& out) {
-  for (size_t k = 0; k < verts.size(); ++k) {
-    const Vec3& v = verts[k];
-    long i, j;
-    int t;
-    if (!g.locate(v.x(), v.y(), i, j, t)) continue;
-    const Tri T = makeTri(g, i, j, t);
-    const Real sep = T.n.dot(v - T.a);
-    if (sep > margin) continue;
-    out.push_back(makeContact(v - T.n * (Real(0.5) * sep), T.n, -sep, T.index * 8 + uint32_t(k & 7)));
+constexpr Real kRelTol = 0.05;  // an axis must beat the preferred one by this much (relative) ...
+constexpr Real kAbsTol = 1e-7;  // ... plus this (absolute), so ties keep the triangle normal
+
+/// Unique unit edge directions of a polytope.
+void uniqueEdgeDirs(const Polytope& P, std::vector<Vec3>& dirs) {
+  dirs.clear();
+  for (const auto& e : P.edges) {
+    Vec3 d = P.verts[e.second] - P.verts[e.first];
+    const Real len = d.norm();
+    if (len < Real(1e-12)) continue;
+    d /= len;
+    bool dup = false;
+    for (const Vec3& o : dirs) dup = dup || o.cross(d).squaredNorm() < Real(1e-12);
+    if (!dup) dirs.push_back(d);
   }
 }
 
-/// A convex shape's "faces" for the inside test: outward normal and signed distance of a point.
-struct FaceDist {
-  Vec3 m;
-  Real sep;
-};
-
-/// (b) sharp height-field vertices inside the shape. `inside(p, faces)` fills the face distances of point p
-/// (height-field frame). Only faces facing down (m.z < -0.1) can take the push: the height field is solid below
-/// and never pushes a shape sideways or down through itself.
-template <class InsideFn>
-void sharpVerticesInside(const Grid& g, long i0, long i1, long j0, long j1, Real margin, InsideFn inside,
-                         std::vector<ContactPoint>& out) {
-  static constexpr int kNb[6][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, -1}};
-  thread_local std::vector<FaceDist> faces;
-  const Real tol = Real(1e-9) * (g.dx + g.dy);
-  for (long vj = j0; vj <= j1 + 1; ++vj) {
-    for (long vi = i0; vi <= i1 + 1; ++vi) {
-      const Vec3 p = g.vert(vi, vj);
-      faces.clear();
-      inside(p, faces);
-      Real maxSep = -std::numeric_limits<Real>::max();
-      const FaceDist* best = nullptr;
-      bool in = !faces.empty();
-      for (const FaceDist& f : faces) {
-        if (f.sep > margin) {
-          in = false;
-          break;
-        }
-        if (f.m.z() < Real(-0.1) && f.sep > maxSep) {
-          maxSep = f.sep;
-          best = &f;
-        }
-      }
-      if (!in || !best) continue;
-      const Vec3 N = -best->m;  // from the height field towards the shape
-      // Sharp vertex: no neighbour above the plane through p with normal N, at least one strictly below.
-      bool sharp = false, blocked = false;
-      for (const auto& o : kNb) {
-        const long ni = vi + o[0], nj = vj + o[1];
-        if (ni < 0 || nj < 0 || ni >= g.nx || nj >= g.ny) continue;
-        const Real h = N.dot(g.vert(ni, nj) - p);
-        if (h > tol) blocked = true;
-        if (h < -tol) sharp = true;
-      }
-      if (blocked || !sharp) continue;
-      const Real depth = -maxSep;
-      out.push_back(makeContact(p + N * (Real(0.5) * depth), N, depth, 0x80000000u | uint32_t(vj * g.nx + vi)));
+/// Opposite vertex of the neighbour across edge `k` (0 ab, 1 bc, 2 ca) of triangle (i, j, t); false on the border.
+bool neighbourApex(const Grid& g, long i, long j, int t, int k, Vec3& w) {
+  long ni, nj;
+  int nt;
+  if (!edgeNeighbour(g, i, j, t, k + 1, ni, nj, nt)) return false;
+  const Tri N = makeTri(g, ni, nj, nt);
+  long tv[3][2];
+  g.triVerts(i, j, t, tv);
+  const Vec3 nv[3] = {N.a, N.b, N.c};
+  for (int m = 0; m < 3; ++m) {
+    bool shared = false;
+    for (const auto& p : tv) shared = shared || (p[0] == N.v[m][0] && p[1] == N.v[m][1]);
+    if (!shared) {
+      w = nv[m];
+      return true;
     }
   }
+  return false;
 }
 
-int polytopeHeightField(const Polytope& P, const Grid& g, long i0, long i1, long j0, long j1, Real margin,
-                        std::vector<ContactPoint>& out) {
+/// Is edge k of the triangle an internal flat join (the neighbour lies in the same plane)?
+bool flatJoin(const Grid& g, long i, long j, int t, const Tri& T, int k, Real tol) {
+  Vec3 w;
+  if (!neighbourApex(g, i, j, t, k, w)) return false;
+  return std::abs(T.n.dot(w - T.a)) <= tol;
+}
+
+/// Is L (unit, from the height field towards the shape) a valid surface normal at the triangle's feature that
+/// supports it? The feature (face, edge or vertex: the triangle points farthest along L) must be the support of
+/// the whole local surface along L, i.e. every neighbouring grid vertex lies on or below the plane through the
+/// feature with normal L. That is the Gauss-map cone test: for an edge, L lies between the two triangle normals
+/// of a convex join (none for a flat or concave join but the face normal); for a vertex, in its normal cone.
+bool validNormal(const Grid& g, long i, long j, int t, const Tri& T, const Vec3& L, Real tol) {
+  if (L.dot(T.n) <= Real(1e-9)) return false;
+  const Vec3 v[3] = {T.a, T.b, T.c};
+  const Real h[3] = {L.dot(T.a), L.dot(T.b), L.dot(T.c)};
+  const Real hi = std::max({h[0], h[1], h[2]});
+  bool sup[3];
+  int count = 0;
+  for (int m = 0; m < 3; ++m) count += (sup[m] = h[m] >= hi - tol) ? 1 : 0;
+  if (count == 3) return L.dot(T.n) >= 1 - Real(1e-9);
+  if (count == 2) {
+    const int k = !sup[0] ? 1 : (!sup[1] ? 2 : 0);  // edge (k, k+1) holds the two supporting vertices
+    Vec3 w;
+    if (!neighbourApex(g, i, j, t, k, w)) return true;
+    return L.dot(w - v[k]) <= tol;
+  }
+  const int m = sup[0] ? 0 : (sup[1] ? 1 : 2);
+  static constexpr int kNb[6][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, -1}};
+  for (const auto& o : kNb) {
+    const long ni = T.v[m][0] + o[0], nj = T.v[m][1] + o[1];
+    if (ni < 0 || nj < 0 || ni >= g.nx || nj >= g.ny) continue;
+    if (L.dot(g.vert(ni, nj) - v[m]) > tol) return false;
+  }
+  return true;
+}
+
+uint32_t localId(uint32_t a, uint32_t b) {
+  uint32_t h = a * 0x9E3779B1u ^ (b * 0x85EBCA6Bu + 0x7F4A7C15u);
+  h ^= h >> 15;
+  return h & 7u;
+}
+
+/// Triangle (i, j, t) against polytope P (height-field frame). Appends points (deduplicated against
+/// out[begin..)). `capFaces`: faces with more than 4 vertices approximate round caps, so only their own
+/// vertices (on the true rim) become points, not clip crossings.
+void polytopeTriangle(const Grid& g, long i, long j, int t, const Polytope& P, const std::vector<Vec3>& dirs,
+                      Real margin, bool capFaces, size_t begin, std::vector<ContactPoint>& out) {
+  const Tri T = makeTri(g, i, j, t);
+  const Vec3 tv[3] = {T.a, T.b, T.c};
+  const Real scale = g.dx + g.dy + std::abs(T.a.z());
+  const Real tol = Real(1e-9) * scale;
+  // 1. triangle normal (always valid; the height field is solid below, so only +n).
+  Real sepN = std::numeric_limits<Real>::max();
+  for (const Vec3& v : P.verts) sepN = std::min(sepN, T.n.dot(v - T.a));
+  if (sepN > margin) return;
+  int kind = 0, fBest = -1, eTri = -1;
+  Vec3 N = T.n, eDir = Vec3::Zero();
+  Real best = sepN;
+  // 2. polytope face normals: the triangle outside face f, normal -m.
+  for (size_t f = 0; f < P.faces.size(); ++f) {
+    const auto& F = P.faces[f];
+    Real s = std::numeric_limits<Real>::max();
+    for (const Vec3& x : tv) s = std::min(s, F.normal.dot(x) - F.offset);
+    if (s > margin) return;
+    if (s > best + kRelTol * std::abs(best) + kAbsTol && validNormal(g, i, j, t, T, -F.normal, tol)) {
+      best = s;
+      kind = 1;
+      fBest = int(f);
+      N = -F.normal;
+    }
+  }
+  // 3. triangle edge x polytope edge directions.
+  const Real faceBest = best;
+  Real bestE = -std::numeric_limits<Real>::max();
+  Vec3 NE = Vec3::Zero(), dE = Vec3::Zero();
+  int kE = -1;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 e = tv[(k + 1) % 3] - tv[k];
+    for (const Vec3& d : dirs) {
+      Vec3 L = e.cross(d);
+      const Real len = L.norm();
+      if (len < Real(1e-6) * e.norm()) continue;
+      L /= len;
+      Real pLo = std::numeric_limits<Real>::max(), pHi = -pLo, tLo = pLo, tHi = -pLo;
+      for (const Vec3& v : P.verts) {
+        const Real x = L.dot(v);
+        pLo = std::min(pLo, x);
+        pHi = std::max(pHi, x);
+      }
+      for (const Vec3& v : tv) {
+        const Real x = L.dot(v);
+        tLo = std::min(tLo, x);
+        tHi = std::max(tHi, x);
+      }
+      const Real s1 = pLo - tHi, s2 = tLo - pHi;
+      const Real s = std::max(s1, s2);
+      if (s > margin) return;
+      const Vec3 Ls = s1 >= s2 ? L : Vec3(-L);
+      if (s > bestE && validNormal(g, i, j, t, T, Ls, tol)) {
+        bestE = s;
+        NE = Ls;
+        dE = d;
+        kE = k;
+      }
+    }
+  }
+  if (kE >= 0 && bestE > faceBest + kRelTol * std::abs(faceBest) + kAbsTol) {
+    kind = 2;
+    best = bestE;
+    N = NE;
+    eDir = dE;
+    eTri = kE;
+  }
+
+  if (kind == 2) {
+    // Closest points of the triangle edge and the polytope's supporting edge along -N.
+    int pe = -1;
+    Real low = std::numeric_limits<Real>::max();
+    for (size_t q = 0; q < P.edges.size(); ++q) {
+      const Vec3 a = P.verts[P.edges[q].first], b = P.verts[P.edges[q].second];
+      if ((b - a).normalized().cross(eDir).squaredNorm() > Real(1e-10)) continue;
+      const Real v = N.dot(a + b);
+      if (v < low) {
+        low = v;
+        pe = int(q);
+      }
+    }
+    if (pe < 0) return;
+    const Vec3 a0 = tv[eTri], a1 = tv[(eTri + 1) % 3];
+    const Vec3 b0 = P.verts[P.edges[size_t(pe)].first], b1 = P.verts[P.edges[size_t(pe)].second];
+    Real s, u;
+    closestSegmentSegment(a0, a1, b0, b1, s, u);
+    const Vec3 p = Real(0.5) * ((a0 + s * (a1 - a0)) + (b0 + u * (b1 - b0)));
+    if (!nearExisting(out, begin, p)) out.push_back(makeContact(p, N, -best, T.index * 8 + 7));
+    return;
+  }
+
+  thread_local std::vector<Vec3> ref, inc;
+  thread_local std::vector<ClipVertex> poly, scratch;
+  ref.clear();
+  inc.clear();
+  if (kind == 0) {
+    // Reference: the triangle; incident: the polytope face most anti-parallel to n.
+    int fi = 0;
+    Real lo = std::numeric_limits<Real>::max();
+    for (size_t f = 0; f < P.faces.size(); ++f) {
+      const Real d = P.faces[f].normal.dot(T.n);
+      if (d < lo) {
+        lo = d;
+        fi = int(f);
+      }
+    }
+    const auto& IF = P.faces[size_t(fi)];
+    for (uint32_t k = 0; k < IF.count; ++k) inc.push_back(P.verts[P.indices[IF.first + k]]);
+    initIncident(inc.data(), int(inc.size()), poly);
+    clipToReference(poly, tv, 3, T.n, scratch);
+    const bool cap = capFaces && IF.count > 4;
+    bool flat[3];
+    for (int k = 0; k < 3; ++k) flat[k] = flatJoin(g, i, j, t, T, k, tol);
+    for (const ClipVertex& v : poly) {
+      // Crossings of a flat internal join lie inside the merged contact region (the neighbour continues it).
+      const bool onA = v.la >= 64, onB = v.lb >= 64;
+      if (cap && (onA || onB)) continue;
+      if ((onA || onB) && (!onA || flat[v.la - 64]) && (!onB || flat[v.lb - 64])) continue;
+      const Real sep = T.n.dot(v.p - T.a);
+      if (sep > margin) continue;
+      const Vec3 p = v.p - T.n * (Real(0.5) * sep);
+      if (nearExisting(out, begin, p)) continue;
+      out.push_back(makeContact(p, T.n, -sep, T.index * 8 + localId(uint32_t(fi), clipLabel(v))));
+    }
+    return;
+  }
+  // kind 1: reference = polytope face fBest, incident = the triangle.
+  const auto& RF = P.faces[size_t(fBest)];
+  for (uint32_t k = 0; k < RF.count; ++k) ref.push_back(P.verts[P.indices[RF.first + k]]);
+  initIncident(tv, 3, poly);
+  clipToReference(poly, ref.data(), int(ref.size()), RF.normal, scratch);
+  for (const ClipVertex& v : poly) {
+    const Real sep = RF.normal.dot(v.p) - RF.offset;
+    if (sep > margin) continue;
+    const Vec3 p = v.p - RF.normal * (Real(0.5) * sep);
+    if (nearExisting(out, begin, p)) continue;
+    out.push_back(makeContact(p, N, -sep, T.index * 8 + localId(uint32_t(fBest) | 0x100u, clipLabel(v))));
+  }
+}
+
+/// Cylinder as an n-gon prism (height-field frame). Vertex 0 of each cap sits at the rim point deepest along -up
+/// (fixed at local +x when the cylinder is nearly parallel to up). Built per triangle with up = the triangle
+/// normal, so face contacts of a lying cylinder (its lowest generator) and of an upright one (its rim) are exact;
+/// elsewhere the prism is inside the cylinder by at most r (1 - cos(pi / n)).
+void makeCylinderPrism(Real r, Real hh, const Transform& rel, const Vec3& up, int n, Polytope& P) {
+  P.clear();
+  const Vec3 upL = rel.rotateInverse(up);
+  const Real rl = std::hypot(upL.x(), upL.z());
+  const Real phi0 = rl < Real(0.045) ? Real(0) : std::atan2(-upL.z(), -upL.x());
+  for (int s = 0; s < 2; ++s) {
+    const Real y = s ? hh : -hh;
+    for (int k = 0; k < n; ++k) {
+      const Real a = phi0 + Real(6.283185307179586) * Real(k) / Real(n);
+      P.verts.push_back(rel.apply(Vec3(r * std::cos(a), y, r * std::sin(a))));
+    }
+  }
+  const Vec3 c = rel.p;
+  auto addFace = [&](std::vector<uint32_t> idx, const Vec3& outward) {
+    Vec3 nrm = Vec3::Zero();
+    for (size_t k = 0; k < idx.size(); ++k) {
+      const Vec3& p = P.verts[idx[k]];
+      const Vec3& q = P.verts[idx[(k + 1) % idx.size()]];
+      nrm += p.cross(q);
+    }
+    if (nrm.dot(outward) < 0) {
+      std::reverse(idx.begin(), idx.end());
+      nrm = -nrm;
+    }
+    Polytope::Face F;
+    F.first = uint32_t(P.indices.size());
+    F.count = uint32_t(idx.size());
+    F.normal = nrm.normalized();
+    F.offset = F.normal.dot(P.verts[idx[0]]);
+    for (uint32_t x : idx) P.indices.push_back(x);
+    P.faces.push_back(F);
+  };
+  const Vec3 w = rel.rotate(Vec3::UnitY());
+  std::vector<uint32_t> bottom, top;
+  for (int k = 0; k < n; ++k) {
+    bottom.push_back(uint32_t(k));
+    top.push_back(uint32_t(n + k));
+  }
+  addFace(bottom, -w);
+  addFace(top, w);
+  for (int k = 0; k < n; ++k) {
+    const uint32_t a = uint32_t(k), b = uint32_t((k + 1) % n);
+    const Vec3 mid = Real(0.5) * (P.verts[a] + P.verts[b]) - c;
+    addFace({a, b, b + uint32_t(n), a + uint32_t(n)}, mid - w * w.dot(mid));
+    P.edges.emplace_back(a, b);
+    P.edges.emplace_back(a + uint32_t(n), b + uint32_t(n));
+    P.edges.emplace_back(a, a + uint32_t(n));
+  }
+}
+
+struct CylinderPrism {
+  Real r, hh;
+  const Transform* rel;
+};
+constexpr int kCylinderSides = 16;
+
+/// `cyl` set: P is rebuilt per triangle as a prism aligned with the triangle normal.
+int polytopeHeightField(Polytope& P, const Grid& g, long i0, long i1, long j0, long j1, Real margin,
+                        const CylinderPrism* cyl, std::vector<ContactPoint>& out) {
   const size_t begin = out.size();
-  verticesBelow(g, P.verts, margin, out);
-  sharpVerticesInside(
-      g, i0, i1, j0, j1, margin,
-      [&P](const Vec3& p, std::vector<FaceDist>& f) {
-        for (const auto& F : P.faces) f.push_back({F.normal, F.normal.dot(p) - F.offset});
-      },
-      out);
+  thread_local std::vector<Vec3> dirs;
+  if (cyl) makeCylinderPrism(cyl->r, cyl->hh, *cyl->rel, Vec3::UnitZ(), kCylinderSides, P);
+  uniqueEdgeDirs(P, dirs);
+  Real zlo = std::numeric_limits<Real>::max();
+  for (const Vec3& v : P.verts) zlo = std::min(zlo, v.z());
+  for (long j = j0; j <= j1; ++j) {
+    for (long i = i0; i <= i1; ++i) {
+      for (int t = 0; t < 2; ++t) {
+        long vv[3][2];
+        g.triVerts(i, j, t, vv);
+        Real zhi = -std::numeric_limits<Real>::max();
+        for (const auto& p : vv) zhi = std::max(zhi, g.hf.getHeight(size_t(p[0]), size_t(p[1])));
+        if (zhi < zlo - margin) continue;  // the whole triangle lies below the shape by more than the margin
+        if (cyl) {
+          makeCylinderPrism(cyl->r, cyl->hh, *cyl->rel, makeTri(g, i, j, t).n, kCylinderSides, P);
+          uniqueEdgeDirs(P, dirs);
+        }
+        polytopeTriangle(g, i, j, t, P, dirs, margin, cyl != nullptr, begin, out);
+      }
+    }
+  }
   return int(out.size() - begin);
 }
 
@@ -341,7 +580,7 @@ int collideBoxHeightField(const Shape& s0, const Transform& t0, const Shape& s1,
   thread_local Polytope P;
   makeBoxPolytope(static_cast<const Box&>(s0).getHalfExtents(), rel, P);
   const size_t begin = out.size();
-  polytopeHeightField(P, g, i0, i1, j0, j1, margin, out);
+  polytopeHeightField(P, g, i0, i1, j0, j1, margin, nullptr, out);
   return finish(out, begin, t1);
 }
 
@@ -354,7 +593,7 @@ int collideConvexHeightField(const Shape& s0, const Transform& t0, const Shape& 
   thread_local Polytope P;
   makeConvexPolytope(static_cast<const Convex&>(s0), rel, P);
   const size_t begin = out.size();
-  polytopeHeightField(P, g, i0, i1, j0, j1, margin, out);
+  polytopeHeightField(P, g, i0, i1, j0, j1, margin, nullptr, out);
   return finish(out, begin, t1);
 }
 
@@ -362,37 +601,13 @@ int collideCylinderHeightField(const Shape& s0, const Transform& t0, const Shape
                                Real margin, std::vector<ContactPoint>& out) {
   const Grid g(static_cast<const HeightField&>(s1));
   const auto& cyl = static_cast<const Cylinder&>(s0);
-  const Real r = cyl.getRadius(), hh = Real(0.5) * cyl.getHeight();
   const Transform rel = t1.inverse() * t0;
   long i0, i1, j0, j1;
   if (!footprint(s0, rel, g, margin, i0, i1, j0, j1)) return 0;
-  // Rim points (height-field frame) as in cylinderPlane, with the height field's +z as "up".
-  const Vec3 upL = rel.rotateInverse(Vec3::UnitZ());
-  thread_local std::vector<Vec3> rim;
-  rim.clear();
-  const Vec3 radial(upL.x(), 0, upL.z());
-  const Real rl = radial.norm();
-  if (rl < Real(0.045)) {
-    const Real cy = upL.y() > 0 ? -hh : hh;
-    for (const Vec3& l : {Vec3(r, cy, 0), Vec3(0, cy, r), Vec3(-r, cy, 0), Vec3(0, cy, -r)}) rim.push_back(rel.apply(l));
-  } else {
-    const Vec3 u = -radial / rl;
-    rim.push_back(rel.apply(Vec3(u.x() * r, -hh, u.z() * r)));
-    rim.push_back(rel.apply(Vec3(u.x() * r, hh, u.z() * r)));
-  }
+  thread_local Polytope P;
+  const CylinderPrism cp{cyl.getRadius(), Real(0.5) * cyl.getHeight(), &rel};
   const size_t begin = out.size();
-  verticesBelow(g, rim, margin, out);
-  const Vec3 w = rel.rotate(Vec3::UnitY());
-  sharpVerticesInside(
-      g, i0, i1, j0, j1, margin,
-      [&](const Vec3& p, std::vector<FaceDist>& f) {
-        const Vec3 q = rel.applyInverse(p);
-        f.push_back({w, q.y() - hh});
-        f.push_back({-w, -q.y() - hh});
-        const Real rho = std::hypot(q.x(), q.z());
-        if (rho > Real(1e-12)) f.push_back({rel.rotate(Vec3(q.x() / rho, 0, q.z() / rho)), rho - r});
-      },
-      out);
+  polytopeHeightField(P, g, i0, i1, j0, j1, margin, &cp, out);
   return finish(out, begin, t1);
 }
 
