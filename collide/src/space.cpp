@@ -90,7 +90,9 @@ bool Space::canCollide(const Geometry& a, const Geometry& b) const {
 }
 
 void Space::collide(Real h, std::vector<GeometryContact>& out) {
-  out.clear();
+  // The contacts of the last step are re-targeted in place, so their point buffers are reused: no per-contact
+  // allocation in a steady scene.
+  size_t used = 0;
   if (!(std::isfinite(h) && h >= 0)) h = 0;  // no exceptions inside the step; Simulation validates h
   const size_t n = geoms_.size();
   boxes_.resize(n);
@@ -129,11 +131,14 @@ void Space::collide(Real h, std::vector<GeometryContact>& out) {
     if (ga->getId() > gb->getId()) std::swap(ga, gb);
     scratchPoints_.clear();
     if (collideGeometries(*ga, *gb, pairMargin, scratchPoints_) <= 0 || scratchPoints_.empty()) continue;
-    GeometryContact& c = out.emplace_back(ga, gb, ga->getRigidBody(), gb->getRigidBody());
+    if (used == out.size()) out.emplace_back();
+    GeometryContact& c = out[used++];
+    c.reset(ga, gb, ga->getRigidBody(), gb->getRigidBody());
     c.points().assign(scratchPoints_.begin(), scratchPoints_.end());
     c.setSensor(ga->isSensor() || gb->isSensor());
   }
 
+  out.resize(used);
   // Deterministic order by (geometry 0 id, geometry 1 id), independent of the geometry list order.
   std::sort(out.begin(), out.end(), [](const GeometryContact& x, const GeometryContact& y) {
     const uint32_t x0 = x.geometry(0)->getId(), y0 = y.geometry(0)->getId();

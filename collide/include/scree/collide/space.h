@@ -40,7 +40,8 @@ class Space {
   UniformGrid& getBroadphase() { return grid_; }
 
   /// Updates world transforms, computes AABBs grown by each body's motion over `h` (speculative contacts),
-  /// runs broad- and narrowphase and appends the touching pairs to `out` (cleared first).
+  /// runs broad- and narrowphase and replaces the contents of `out` with the touching pairs (its elements and
+  /// their point buffers are reused from the last call).
   void collide(Real h, std::vector<GeometryContact>& out);
 
   /// Number of candidate pairs from the broadphase in the last collide().

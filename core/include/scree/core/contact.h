@@ -47,6 +47,20 @@ class GeometryContact {
   GeometryContact() = default;
   GeometryContact(Geometry* g0, Geometry* g1, RigidBody* b0, RigidBody* b1) : geoms_{g0, g1}, bodies_{b0, b1} {}
 
+  /// Re-targets this object at another pair for a new step, keeping the points' storage (no allocation).
+  void reset(Geometry* g0, Geometry* g1, RigidBody* b0, RigidBody* b1) {
+    geoms_[0] = g0;
+    geoms_[1] = g1;
+    bodies_[0] = b0;
+    bodies_[1] = b1;
+    points_.clear();
+    params_ = SurfaceParameters{};
+    friction_ = nullptr;
+    enabled_ = true;
+    impact_ = false;
+    sensor_ = false;
+  }
+
   Geometry* geometry(int i) const { return geoms_[i]; }
   /// The bodies of the geometries (nullptr for a static geometry without a body).
   RigidBody* rigidBody(int i) const { return bodies_[i]; }
