@@ -22,4 +22,5 @@
 #include "scree/solver/solver.h"
 #include "scree/solver/spook.h"
 #include "scree/model/model.h"
+#include "scree/model/two_body_tire_model.h"
 #include "scree/version.h"

@@ -185,11 +185,13 @@ void Simulation::add(ConstraintRef c) {
   constraints_.push_back(c);
   if (!c->getEnableCollisions() && c->getBodyAt(1))
     space_.setEnableCollisions(c->getBodyAt(0), c->getBodyAt(1), false);
+  c->addNotification(*this);
 }
 
 bool Simulation::remove(const ConstraintRef& c) {
   auto it = std::find(constraints_.begin(), constraints_.end(), c);
   if (it == constraints_.end()) return false;
+  c->removeNotification(*this);
   constraints_.erase(it);
   // Re-enable the pair unless another constraint still joins the same bodies without collisions.
   bool stillJoined = false;
@@ -534,6 +536,15 @@ void Simulation::buildRows() {
       int32_t t1Index = -1;
       Vec3 t1, t2;
       orthonormalBasis(n, t1, t2);
+      if (p.frictionDirection != Vec3::Zero()) {
+        // A listener's primary direction (e.g. a tire's rolling direction): its tangential part, if any.
+        const Vec3 d = p.frictionDirection - n.dot(p.frictionDirection) * n;
+        const Real len = d.norm();
+        if (len > 1e-9 * p.frictionDirection.norm()) {
+          t1 = d / len;
+          t2 = n.cross(t1);
+        }
+      }
       if (mu > 0) {
         t1Index = nextFriction;
         const Real eVisc = spookVelocityRegularisation(h, mat.getSurfaceViscosity());

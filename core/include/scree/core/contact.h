@@ -31,6 +31,10 @@ struct ContactPoint {
   /// Target tangential velocity of geometry 0 relative to geometry 1 at the point, world m/s (a conveyor belt).
   /// Only its tangential part is used.
   Vec3 surfaceVelocity = Vec3::Zero();
+  /// Primary friction direction, world (AGX: an oriented friction frame). Zero (default): the solver picks
+  /// an arbitrary tangent basis. Otherwise its tangential part, normalised, is the first friction row and
+  /// normal x that the second (the tire model sets it along the rolling direction).
+  Vec3 frictionDirection = Vec3::Zero();
 
   /// Feature id from the narrowphase (stable while the same features touch); keys warm starting.
   uint32_t featureId = 0;

@@ -17,6 +17,8 @@
 
 namespace scree {
 
+class Simulation;
+
 /// What a constraint needs to write its rows.
 struct ConstraintContext {
   Real h = 1.0 / 60.0;
@@ -62,6 +64,10 @@ class Constraint {
   virtual void addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) = 0;
   /// Receives the solved rows appended by addRows (same order) to keep warm-start impulses and forces.
   virtual void storeResult(const ConstraintRow* rows, const int* dofs, size_t count, Real h);
+  /// Called by Simulation::add / remove (AGX: addNotification / removeNotification): a model built on a
+  /// constraint may register or unregister its listeners here. Default: nothing.
+  virtual void addNotification(Simulation&) {}
+  virtual void removeNotification(Simulation&) {}
 
  protected:
   void checkDof(const char* where, int dof) const;
