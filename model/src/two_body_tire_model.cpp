@@ -63,7 +63,7 @@ TwoBodyTireModel::~TwoBodyTireModel() = default;
 
 void TwoBodyTireModel::checkMode(const char* where, DeformationMode mode) {
   if (int(mode) < 0 || int(mode) >= NUM_MODES)
-    detail::throwInvalid(std::string("TwoBodyTireModel::") + where, "mode", (long long)mode,
+    detail::throwInvalid(std::string("TwoBodyTireModel::") + where, "mode", (long long)int(mode),
                          "must be RADIAL, LATERAL, BENDING or TORSIONAL");
 }
 
