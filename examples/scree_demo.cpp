@@ -2,7 +2,8 @@
 // a 10-box tower, a 6-row pyramid, a box sliding to rest on friction, a bouncing ball (restitution), a heavy
 // box on a light one (1000:1), and a mixed pile of spheres, capsules, cylinders and convex hulls dropped on the
 // ground, plus jointed mechanisms: a motor-driven arm (hinge with a speed motor and a force limit) and a six-link
-// pendulum chain on ball joints. Prints a one-line summary per simulated second.
+// pendulum chain on ball joints. Prints a one-line summary per simulated second. Then a four-wheeled vehicle on
+// TwoBodyTireModel tires drives over a bump (demo_vehicle.h).
 //
 // Usage: scree_demo [seconds=5] [iterations=16]
 #include <cmath>
@@ -12,6 +13,8 @@
 #include <vector>
 
 #include <scree/scree.h>
+
+#include "demo_vehicle.h"
 
 using namespace scree;
 
@@ -144,5 +147,6 @@ int main(int argc, char** argv) {
               expectedSlide);
   std::printf("%d steps, %.3f ms/step (solve %.3f ms)\n", steps, 1000 * totalTime / steps, 1000 * solveTime / steps);
   const auto& report = sim.getLastStepReport();
-  return report.ok() ? 0 : 1;
+  const bool vehicleOk = runVehicleDemo(std::min(seconds, 4.0));
+  return report.ok() && vehicleOk ? 0 : 1;
 }
