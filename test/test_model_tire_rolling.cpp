@@ -193,4 +193,26 @@ TEST_SUITE("tire") {
       CHECK(std::abs(d.normalized().dot(u) - 1) < 1e-6);
     }
   }
+
+  TEST_CASE("tire and rim do not collide while the model is simulated; removing it restores collisions") {
+    TestWorld w(1.0 / 60, 0.0);
+    auto body = [&](Real radius) {
+      auto b = std::make_shared<RigidBody>();
+      auto g = std::make_shared<Geometry>(std::make_shared<Cylinder>(radius, 0.25));
+      g->setMaterial(w.material);
+      b->add(g);
+      w.sim->add(b);
+      return b;
+    };
+    auto tire = body(0.4), rim = body(0.3);  // overlapping at the origin
+    auto model = std::make_shared<TwoBodyTireModel>(tire, 0.4, rim, 0.3);
+    w.sim->add(model);
+    w.steps(2);
+    CHECK(w.sim->getContacts().empty());
+    CHECK(w.sim->remove(model));
+    w.steps(1);
+    CHECK_FALSE(w.sim->getContacts().empty());
+    for (const GeometryContact& c : w.sim->getContacts())
+      for (const ContactPoint& p : c.points()) CHECK(p.frictionDirection == Vec3::Zero());  // listener gone
+  }
 }
