@@ -22,4 +22,5 @@
 #include "scree/solver/solver.h"
 #include "scree/solver/spook.h"
 #include "scree/model/model.h"
+#include "scree/model/suction_gripper.h"
 #include "scree/version.h"
