@@ -263,6 +263,7 @@ void SuctionGripper::add(SuctionCupRef cup, const Vec3& localPosition, const Qua
   joint->setEnableCollisions(false);
   joints_.push_back(joint);
   cup->mount_ = joint;
+  cup->mountLocal_ = {localPosition, localRotation.normalized()};
   add(std::move(cup));
   if (installedIn_) installedIn_->add(joints_.back());
 }
@@ -286,10 +287,41 @@ void SuctionGripper::install(Simulation& sim) {
   for (; installedCups_ < cups_.size(); ++installedCups_) sim.add(cups_[installedCups_]->getRigidBody());
 }
 
+void SuctionGripper::updateMounts() {
+  if (!holder_) return;
+  const bool holderMoves = holder_->isDynamic();
+  for (const auto& cupRef : cups_) {
+    SuctionCup& cup = *cupRef;
+    if (!cup.mount_) continue;
+    RigidBody& b = *cup.getRigidBody();
+    if (holderMoves) {
+      if (cup.kinematicMount_) {
+        b.setMotionControl(RigidBody::DYNAMICS);
+        cup.mount_->setEnable(true);
+        cup.kinematicMount_ = false;
+      }
+      continue;
+    }
+    if (!cup.kinematicMount_) {
+      if (!b.isDynamic() && b.getMotionControl() != RigidBody::KINEMATICS) continue;  // the user's choice
+      b.setMotionControl(RigidBody::KINEMATICS);
+      cup.mount_->setEnable(false);
+      cup.kinematicMount_ = true;
+    }
+    // Rigidly attached: pose from the holder, velocity of the holder's material point at the cup's centre of mass.
+    const Transform t = holder_->getTransform() * cup.mountLocal_;
+    b.setRotation(t.q);
+    b.setPosition(t.p);
+    b.setVelocity(holder_->getVelocityAt(b.getCmPosition()));
+    b.setAngularVelocity(holder_->getAngularVelocity());
+  }
+}
+
 void SuctionGripper::preCollide(const TimeStamp&) {
   Simulation* sim = getSimulation();
   if (!sim) return;
   if (installedIn_ != sim || installedCups_ != cups_.size()) install(*sim);
+  updateMounts();
   for (const auto& cup : cups_) {
     cup->active_.clear();
     cup->vacuumInteraction_ = nullptr;
