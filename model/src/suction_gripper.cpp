@@ -190,13 +190,15 @@ class SuctionGripper::SensorListener : public ContactEventListener {
  public:
   explicit SensorListener(SuctionGripper* g) : ContactEventListener(IMPACT | CONTACT), gripper_(g) {}
   KeepContactPolicy impact(const TimeStamp&, GeometryContact& c) override {
-    gripper_->onSensorContact(c);
+    if (gripper_) gripper_->onSensorContact(c);
     return KEEP_CONTACT;
   }
   KeepContactPolicy contact(const TimeStamp&, GeometryContact& c) override {
-    gripper_->onSensorContact(c);
+    if (gripper_) gripper_->onSensorContact(c);
     return KEEP_CONTACT;
   }
+  /// The simulation may outlive the gripper (if the user removed it): the listener then does nothing.
+  void detach() { gripper_ = nullptr; }
 
  private:
   SuctionGripper* gripper_;
@@ -222,7 +224,7 @@ SuctionGripper::SuctionGripper()
   listener_->setFilter(std::make_shared<GroupSensorFilter>(group_));
 }
 
-SuctionGripper::~SuctionGripper() = default;
+SuctionGripper::~SuctionGripper() { listener_->detach(); }
 
 void SuctionGripper::setHolderRigidBody(RigidBodyRef holder) {
   detail::requireNonNull("SuctionGripper::setHolderRigidBody", "holder", holder.get());
