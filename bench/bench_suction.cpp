@@ -1,6 +1,6 @@
 // Suction gripper cost: N cups (1..64) on one static holder, each cup's lip resting sealed on its own 1 kg box
 // that stands on the ground (10 % vacuum, lip radius 2.5 cm: 19.7 N of vacuum per cup, more than the box's
-// 9.81 N weight, so each box hangs pressed against its cup). The baseline is the same bodies, joints and cup
+// 9.81 N weight, so each box is pulled up against its lip and stays there). The baseline is the same bodies, joints and cup
 // cylinders with no gripper: no sensors, no listener, no vacuum; its boxes rest on the ground instead.
 // Reported: ms/step (median over repetitions), plus counters: cups, sealed cups and the largest box drift
 // from its start (m) in the gripper variant.
