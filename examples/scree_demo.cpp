@@ -2,8 +2,8 @@
 // a 10-box tower, a 6-row pyramid, a box sliding to rest on friction, a bouncing ball (restitution), a heavy
 // box on a light one (1000:1), and a mixed pile of spheres, capsules, cylinders and convex hulls dropped on the
 // ground, plus jointed mechanisms: a motor-driven arm (hinge with a speed motor and a force limit) and a six-link
-// pendulum chain on ball joints. Prints a one-line summary per simulated second. Then a four-wheeled vehicle on
-// TwoBodyTireModel tires drives over a bump (demo_vehicle.h).
+// pendulum chain on ball joints, and a suction gripper pick-and-place (demo_suction.h). Prints a one-line summary
+// per simulated second. Then a four-wheeled vehicle on TwoBodyTireModel tires drives over a bump (demo_vehicle.h).
 //
 // Usage: scree_demo [seconds=5] [iterations=16]
 #include <cmath>
@@ -15,6 +15,7 @@
 #include <scree/scree.h>
 
 #include "demo_vehicle.h"
+#include "demo_suction.h"
 
 using namespace scree;
 
@@ -112,6 +113,9 @@ int main(int argc, char** argv) {
     prevLink = link;
   }
 
+  // Suction gripper: picks a 4 kg box at (0, 17, 0), carries it 1.5 m along x and releases it (pump off).
+  auto suction = SuctionPickPlace::build(sim, stone, Vec3(0, 17, 0));
+
   const Real towerTop0 = tower.back()->getPosition().z();
   const Real pyramidTop0 = pyramidTop->getPosition().z();
   const Real sliderX0 = slider->getPosition().x();
@@ -145,6 +149,7 @@ int main(int argc, char** argv) {
   const Real expectedSlide = 25.0 / (2 * 0.5 * 9.81);
   std::printf("slider stopped after %.4f m (Coulomb: v^2/(2 mu g) = %.4f m)\n", slider->getPosition().x() - sliderX0,
               expectedSlide);
+  suction->printSummary();
   std::printf("%d steps, %.3f ms/step (solve %.3f ms)\n", steps, 1000 * totalTime / steps, 1000 * solveTime / steps);
   const auto& report = sim.getLastStepReport();
   const bool vehicleOk = runVehicleDemo(std::min(seconds, 4.0));

@@ -455,16 +455,45 @@ TEST_SUITE("collide.narrowphase") {
     for (const auto& x : c) CHECK(x.depth == doctest::Approx(-0.01).epsilon(kTol));
   }
 
-  TEST_CASE("libccd pairs: cylinder on box, cylinder on cylinder, speculative gap") {
+  TEST_CASE("cylinder-box: a cap on a face gives a 4-point manifold, clipped at the face edge") {
+    // Upright cylinder (axis y -> z) overlapping the top face by 0.05: four rim points at depth 0.05, the normal
+    // exactly the face normal (the manifold is analytic once libccd has picked the face).
     auto box = place(std::make_shared<Box>(Vec3(2, 2, 0.5)), Vec3(0, 0, -0.5));
     auto cyl = place(std::make_shared<Cylinder>(0.5, 1.0), Vec3(0.1, 0.2, 0.45), rotX(kPi / 2));
     auto c = collide(*cyl, *box);
-    REQUIRE(c.size() == 1);
-    CHECK(c[0].depth == doctest::Approx(0.05).epsilon(kCcdTol));
-    CHECK(near(c[0].normal, Vec3(0, 0, 1), kCcdTol));
+    REQUIRE(c.size() == 4);
+    for (const auto& p : c) {
+      CHECK(p.depth == doctest::Approx(0.05).epsilon(kTol));
+      CHECK(near(p.normal, Vec3(0, 0, 1), kTol));
+      CHECK(std::hypot(p.point.x() - 0.1, p.point.y() - 0.2) == doctest::Approx(0.5).epsilon(kTol));
+      CHECK(p.point.z() == doctest::Approx(-0.025).epsilon(kTol));
+    }
+    // The four points span the cap (they are not bunched on one side): their centroid is the cap centre.
+    Vec3 mean = Vec3::Zero();
+    for (const auto& p : c) mean += p.point / 4.0;
+    CHECK(near(Vec3(mean.x(), mean.y(), 0), Vec3(0.1, 0.2, 0), 1e-9));
     auto s = collide(*box, *cyl);
-    REQUIRE(s.size() == 1);
-    CHECK(near(s[0].normal, Vec3(0, 0, -1), kCcdTol));
+    REQUIRE(s.size() == 4);
+    for (const auto& p : s) CHECK(near(p.normal, Vec3(0, 0, -1), kTol));
+    // Half over the edge x = 2: every point lies on the face (x <= 2), two of them on the edge itself.
+    cyl->setPosition(Vec3(2.0, 0.0, 0.45));
+    c = collide(*cyl, *box);
+    REQUIRE(c.size() >= 3);
+    int onEdge = 0;
+    for (const auto& p : c) {
+      CHECK(p.point.x() <= 2.0 + 1e-9);
+      CHECK(p.depth == doctest::Approx(0.05).epsilon(kTol));
+      if (std::abs(p.point.x() - 2.0) < 1e-9) ++onEdge;
+    }
+    CHECK(onEdge == 2);
+    // Tilted by 0.3 rad: not a cap-on-face contact, the single libccd point stays.
+    cyl->setPosition(Vec3(0.1, 0.2, 0.45));
+    cyl->setRotation(rotX(kPi / 2 + 0.3));
+    CHECK(collide(*cyl, *box).size() == 1);
+  }
+
+  TEST_CASE("libccd pairs: cylinder on cylinder, speculative gap, sphere on hull") {
+    std::vector<ContactPoint> c;
     // Two lying cylinders (axis y) side by side along x, overlapping by 0.04.
     auto c0 = place(std::make_shared<Cylinder>(0.5, 2.0), Vec3(0, 0, 0));
     auto c1 = place(std::make_shared<Cylinder>(0.5, 2.0), Vec3(0.96, 0, 0));

@@ -2,8 +2,8 @@
 //
 // Used for the convex pairs without an analytic routine (cylinder-cylinder, cylinder-box, cylinder-capsule,
 // cylinder-convex, sphere-convex, capsule-convex). One point per call: a curved pair gets a new point every step
-// as it rolls, which is acceptable for these pairs (a cylinder lying on a box therefore rocks on one point per
-// step; an analytic cylinder-box manifold is the upgrade if that shows up in stacking scenes).
+// as it rolls, which is acceptable for these pairs (cylinder-box adds a full manifold for a cap lying on a face,
+// cylinder_box.cpp).
 //
 // Debian's libccd is built with CCD_DOUBLE (ccd/config.h), so ccd_real_t is double like scree::Real; the
 // static_assert below catches a single-precision build instead of silently truncating.

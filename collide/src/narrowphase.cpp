@@ -5,7 +5,8 @@
 // convention right once (normal from its second shape towards its first).
 //
 // Feature ids: sphere pairs 0; capsule ends 1 and 2 (0 for a single closest point); box-plane and convex-plane
-// the vertex index; cylinder-plane cap * 8 + rim point. Lines report only the entry point (id 0).
+// the vertex index; cylinder-plane cap * 8 + rim point; cylinder-box see cylinder_box.cpp. Lines report only
+// the entry point (id 0).
 //
 // Lines are sensors: a line contact is the point where the segment, walked from its first point to its second,
 // enters the shape; the normal is the shape's outward surface normal there and the depth is the length of the
@@ -672,7 +673,7 @@ const Table& table() {
     add(S::SPHERE, S::HEIGHT_FIELD, collideSphereHeightField);
     add(S::BOX, S::BOX, collideBoxBox);
     add(S::BOX, S::PLANE, boxPlane);
-    add(S::BOX, S::CYLINDER, collideCcd);
+    add(S::CYLINDER, S::BOX, collideCylinderBox);
     add(S::BOX, S::HEIGHT_FIELD, collideBoxHeightField);
     add(S::CAPSULE, S::BOX, capsuleBox);
     add(S::CAPSULE, S::CAPSULE, capsuleCapsule);

@@ -122,6 +122,9 @@ int collideConvexPlane(const Shape&, const Transform&, const Shape&, const Trans
                        std::vector<ContactPoint>&);
 /// libccd (MPR, then GJK/EPA) for any two convex shapes with support(); one point per call.
 int collideCcd(const Shape&, const Transform&, const Shape&, const Transform&, Real, std::vector<ContactPoint>&);
+/// Cylinder (shape 0) on a box: full manifold for a cap lying on a face, else the libccd point (cylinder_box.cpp).
+int collideCylinderBox(const Shape&, const Transform&, const Shape&, const Transform&, Real,
+                       std::vector<ContactPoint>&);
 
 /// Shape vs height field: the normal points out of the height field (from shape 1 towards shape 0).
 int collideSphereHeightField(const Shape&, const Transform&, const Shape&, const Transform&, Real,

@@ -23,4 +23,5 @@
 #include "scree/solver/spook.h"
 #include "scree/model/model.h"
 #include "scree/model/two_body_tire_model.h"
+#include "scree/model/suction_gripper.h"
 #include "scree/version.h"
