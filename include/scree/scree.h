@@ -4,6 +4,7 @@
 #include "scree/core/assert.h"
 #include "scree/core/contact.h"
 #include "scree/core/errors.h"
+#include "scree/core/granular_body_system.h"
 #include "scree/core/listeners.h"
 #include "scree/core/logger.h"
 #include "scree/core/material.h"

@@ -16,6 +16,7 @@
 #include "scree/collide/geometry.h"
 #include "scree/collide/space.h"
 #include "scree/core/contact.h"
+#include "scree/core/granular_body_system.h"
 #include "scree/core/listeners.h"
 #include "scree/core/material.h"
 #include "scree/core/rigid_body.h"
@@ -78,6 +79,9 @@ class Simulation {
 
   MaterialManager& getMaterialManager() { return materials_; }
   Solver& getSolver() { return solver_; }
+  /// The particles of this simulation (AGX: agx::GranularBodySystem).
+  GranularBodySystem& getGranularBodySystem() { return granular_; }
+  const GranularBodySystem& getGranularBodySystem() const { return granular_; }
   Space& getSpace() { return space_; }
   /// Disable/enable collisions between two collision groups (see Geometry::addGroup).
   void setEnableCollisions(uint32_t group1, uint32_t group2, bool enable) { space_.setEnablePair(group1, group2, enable); }
@@ -114,6 +118,7 @@ class Simulation {
   MaterialManager materials_;
   Solver solver_;
   Space space_;
+  GranularBodySystem granular_;
   std::vector<GeometryContact> contacts_;
   StepStats stats_;
   StepReport report_;
