@@ -22,5 +22,6 @@
 #include "scree/solver/simulation.h"
 #include "scree/solver/solver.h"
 #include "scree/solver/spook.h"
+#include "scree/model/granular_field_post_processor.h"
 #include "scree/model/model.h"
 #include "scree/version.h"
