@@ -357,6 +357,9 @@ void GranularFieldPostProcessor::calculateFields() {
   const int64_t numVox = int64_t(getNumVoxels());
   SCREE_FIELDS_PARALLEL_FOR
   for (int64_t vox = 0; vox < numVox; ++vox) {
+    if (solid) solid[vox] *= invVoxelVolume;
+    // An empty voxel keeps the zeros written above (velocity 0 by convention, no fluctuation).
+    if (mass && mass[vox] == 0) continue;
     if (velocity) {
       const Real m = mass[vox];
       for (int c = 0; c < 3; ++c) velocity[3 * vox + c] = m > 0 ? momentum[3 * vox + c] / m : Real(0);
@@ -370,7 +373,6 @@ void GranularFieldPostProcessor::calculateFields() {
                                s[3] - m * vb[0] * vb[1], s[4] - m * vb[1] * vb[2], s[5] - m * vb[0] * vb[2]};
       for (int c = 0; c < 6; ++c) s[c] = centred[c] * invVoxelVolume;
     }
-    if (solid) solid[vox] *= invVoxelVolume;
   }
   numInside_ = inside;
   ++numCalculations_;

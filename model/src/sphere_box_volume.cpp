@@ -42,6 +42,20 @@ Real cornerF(Real r, Real a, Real b, Real z) {
          Real(0.5) * antiderivativeH(r, b, z);
 }
 
+/// F(Z) at the top of the z-range, Z = sqrt(r^2 - a^2 - b^2) > 0, a, b >= 0. There q_a = b, q_b = a and
+/// asin(a/rho) + asin(b/rho) = pi/2, so the pi/4 term cancels against the first terms of H_a and H_b and what is
+/// left needs four atan2 and no asin (cheaper, and no cancellation of O(r^3) terms):
+///   F(Z) = a b Z/3 - a (r^2 - a^2/3) atan2(Z, b)/2 - b (r^2 - b^2/3) atan2(Z, a)/2
+///          + r^3/3 (atan2(a Z, r b) + atan2(b Z, r a)).
+/// For a = b = 0 both H vanish and F(r) = pi r^3/6.
+Real cornerFTop(Real r, Real a, Real b, Real zTop) {
+  if (a == 0 && b == 0) return kPi / 6 * r * r * r;
+  const Real r2 = r * r;
+  return a * b * zTop / 3 - Real(0.5) * a * (r2 - a * a / 3) * std::atan2(zTop, b) -
+         Real(0.5) * b * (r2 - b * b / 3) * std::atan2(zTop, a) +
+         r2 * r / 3 * (std::atan2(a * zTop, r * b) + std::atan2(b * zTop, r * a));
+}
+
 /// Spherical cap {x >= a}, a >= 0.
 Real capVolume(Real r, Real a) {
   if (a >= r) return 0;
@@ -52,15 +66,15 @@ Real capVolume(Real r, Real a) {
 Real wedgeVolume(Real r, Real a, Real b) {
   const Real z2 = r * r - a * a - b * b;
   if (z2 <= 0) return 0;
-  return 2 * cornerF(r, a, b, std::sqrt(z2));  // F is odd: [F]_{-Z}^{Z} = 2 F(Z)
+  return 2 * cornerFTop(r, a, b, std::sqrt(z2));  // F is odd: [F]_{-Z}^{Z} = 2 F(Z)
 }
 
-/// {x >= a, y >= b, z >= c}, a, b, c >= 0.
-Real octantCornerVolume(Real r, Real a, Real b, Real c) {
+/// {x >= a, y >= b, z >= c}, a, b, c >= 0; fTop = F(Z) of the pair (a, b) when the caller has it.
+Real octantCornerVolume(Real r, Real a, Real b, Real c, const Real* fTop = nullptr) {
   const Real z2 = r * r - a * a - b * b;
   if (z2 <= c * c) return 0;
-  const Real zTop = std::sqrt(z2);
-  return std::max(Real(0), cornerF(r, a, b, zTop) - cornerF(r, a, b, c));
+  const Real top = fTop ? *fTop : cornerFTop(r, a, b, std::sqrt(z2));
+  return std::max(Real(0), top - cornerF(r, a, b, c));
 }
 
 /// Corner volume for n nonnegative thresholds t[0..n) (the ball is symmetric under axis permutations, so only
@@ -98,8 +112,6 @@ Real signedCorner(Real r, const Real* t, int n) {
 }
 
 }  // namespace
-
-Real ballVolume(Real r) { return Real(4) / 3 * kPi * r * r * r; }
 
 Real ballCornerVolume(Real r, const Vec3& t, const std::array<bool, 3>& has) {
   Real v[3];
@@ -151,13 +163,26 @@ std::array<Real, 8> ballSplitVolumes(Real r, const Vec3& d, const std::array<boo
     ++k;
   }
   // Corner volumes C(S) for every subset S of the cut axes (nonnegative offsets).
+  // With three cuts the octant corner reuses F(Z) of the wedge of axes 0 and 1 (subset 0b011).
   Real corner[8];
+  Real fTop01 = 0;
+  bool haveTop01 = false;
   for (unsigned s = 0; s < (1u << k); ++s) {
     Real t[3];
     int n = 0;
     for (int j = 0; j < k; ++j)
       if (s & (1u << j)) t[n++] = alpha[j];
-    corner[s] = nonnegCorner(r, t, n);
+    if (n == 2) {
+      const Real z2 = r * r - t[0] * t[0] - t[1] * t[1];
+      Real top = 0;
+      if (z2 > 0) top = cornerFTop(r, t[0], t[1], std::sqrt(z2));
+      if (s == 3u) { fTop01 = top; haveTop01 = true; }
+      corner[s] = 2 * top;
+    } else if (n == 3 && haveTop01) {
+      corner[s] = octantCornerVolume(r, t[0], t[1], t[2], &fTop01);
+    } else {
+      corner[s] = nonnegCorner(r, t, n);
+    }
   }
   std::array<Real, 8> pieces{};
   const unsigned all = (1u << k) - 1;

@@ -20,8 +20,8 @@
 
 namespace scree::detail {
 
-/// Volume of the ball of radius r centred at the origin, m^3.
-Real ballVolume(Real r);
+/// Volume of the ball of radius r, m^3.
+inline Real ballVolume(Real r) { return Real(4) / 3 * Real(3.14159265358979323846) * r * r * r; }
 
 /// |{ |p| <= r, p_i >= t_i for the axes i where has[i] }|. Any sign of t; absent axes are unconstrained.
 Real ballCornerVolume(Real r, const Vec3& t, const std::array<bool, 3>& has);
