@@ -5,7 +5,9 @@
 #include <cmath>
 #include <initializer_list>
 #include <limits>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "scree/core/granular_body_system.h"
 #include "scree/model/granular_field_post_processor.h"
@@ -90,6 +92,37 @@ TEST_CASE("a custom buffer removed after addField is reported by calculateFields
   gbs.removeCustomBufferReal("c");
   expectInvalid([&] { gpp.calculateFields(); }, {"\"c\"", "removed"});
   CHECK(gpp.getNumCalculations() == 1);
+}
+
+TEST_CASE("a custom field may not take a built-in field's name") {
+  GranularBodySystem gbs;
+  gbs.addCustomBufferReal("velocity");
+  GranularFieldPostProcessor gpp(gbs, {2, 2, 2}, Vec3(1, 1, 1));
+  expectInvalid([&] { gpp.addField(std::make_shared<GranularCustomBufferField>("velocity")); }, {"\"velocity\"", "built-in"});
+  CHECK(gpp.getFields().empty());
+}
+
+TEST_CASE("a particle with a non-finite state is named instead of spreading NaN") {
+  GranularBodySystem gbs;
+  GranularFieldPostProcessor gpp(gbs, {2, 2, 2}, Vec3(1, 1, 1));
+  auto velocity = gpp.addField(GranularField::VELOCITY);
+  gbs.createParticle(Vec3(0.1, 0.1, 0.1), 0.05, Vec3(1, 0, 0));
+  const size_t bad = gbs.createParticle(Vec3(-0.2, 0.1, 0.1), 0.05);
+  gpp.calculateFields();
+  const std::vector<Real> before(velocity->getFieldData(), velocity->getFieldData() + velocity->getDataSize());
+  // A blown-up solver writes the dense arrays directly (the setters would refuse NaN).
+  gbs.velocities()[gbs.denseIndex(bad)] = Vec3(std::nan(""), 0, 0);
+  bool thrown = false;
+  try {
+    gpp.calculateFields();
+  } catch (const std::runtime_error& e) {
+    thrown = true;
+    const std::string what = e.what();
+    CHECK(what.find("particle id " + std::to_string(bad)) != std::string::npos);
+    CHECK(what.find("non-finite") != std::string::npos);
+  }
+  CHECK(thrown);
+  CHECK(std::vector<Real>(velocity->getFieldData(), velocity->getFieldData() + velocity->getDataSize()) == before);
 }
 
 TEST_CASE("exports reject a bad axis or index") {

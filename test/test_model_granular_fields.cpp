@@ -19,6 +19,7 @@
 #endif
 
 #include "scree/core/granular_body_system.h"
+#include "scree/core/logger.h"
 #include "scree/core/material.h"
 #include "scree/model/granular_field_post_processor.h"
 #include "scree/solver/simulation.h"
@@ -440,6 +441,17 @@ TEST_CASE("a step listener computes the fields every N steps") {
   for (int s = 0; s < 7; ++s) sim.stepForward();
   CHECK(gpp->getNumCalculations() == 2);
   CHECK(calls == std::vector<size_t>{3, 6});
+  // A particle too large for the voxels: the listener logs and skips, the step goes on.
+  gbs.createParticle(Vec3(0.1, 0.1, 0.1), 0.2);
+  std::vector<std::string> errors;
+  Logger::setSink([&](LogLevel level, const std::string& m) {
+    if (level == LogLevel::ERROR) errors.push_back(m);
+  });
+  for (int s = 0; s < 3; ++s) CHECK_NOTHROW(sim.stepForward());
+  Logger::setSink({});
+  CHECK(gpp->getNumCalculations() == 2);
+  REQUIRE(errors.size() == 1);
+  CHECK(errors[0].find("diameter 0.4") != std::string::npos);
 }
 
 }  // TEST_SUITE

@@ -128,6 +128,11 @@ void GranularFieldPostProcessor::attach(const GranularFieldRef& field) {
 GranularFieldRef GranularFieldPostProcessor::addField(GranularFieldRef field) {
   constexpr const char* where = "GranularFieldPostProcessor::addField";
   detail::requireNonNull(where, "field", field.get());
+  if (field->getType() == GranularField::CUSTOM)
+    for (const char* reserved : {"mass", "momentum", "velocity", "solid_volume_fraction", "kinetic_stress"})
+      if (field->getName() == reserved)
+        detail::throwInvalid(where, "field (custom buffer name)", field->getName(),
+                             "the name of a built-in field; rename the custom buffer");
   if (field->getType() == GranularField::CUSTOM && !gbs_->hasCustomBufferReal(field->getName()))
     detail::throwInvalid(where, "field (custom buffer name)", field->getName(),
                          "no custom real buffer of that name in the GranularBodySystem");
@@ -228,15 +233,22 @@ void GranularFieldPostProcessor::calculateFields() {
   // ---- pass 1 (parallel): per particle, the lowest voxel it touches and its weight in each of the <= 8 voxels.
   // Voxel sides >= the diameter, so along each axis the sphere meets voxel c or voxels c and c+1, cut by the
   // plane between them.
-  size_t firstTooLarge = n;  // dense index of the first offending particle (min over threads: deterministic)
+  const auto& vel = gbs.velocities();
+  const auto& masses = gbs.masses();
+  // Dense indices of the first offending particles (min over threads: deterministic).
+  size_t firstTooLarge = n, firstNonFinite = n;
 #ifdef SCREE_WITH_OPENMP
-#pragma omp parallel for schedule(static) reduction(min : firstTooLarge)
+#pragma omp parallel for schedule(static) reduction(min : firstTooLarge, firstNonFinite)
 #endif
   for (size_t p = 0; p < n; ++p) {
     auto& base = baseCell_[p];
     base[0] = kSkip;
     if (!gbs.isAliveDense(p)) continue;
     const Real r = radii[p];
+    if (!pos[p].allFinite() || !vel[p].allFinite() || !std::isfinite(masses[p])) {
+      firstNonFinite = std::min(firstNonFinite, p);
+      continue;
+    }
     const Vec3 x = toLocal * (pos[p] - transform_.p) - lo;  // relative to the cuboid's low corner
     bool outside = false;
     for (int a = 0; a < 3; ++a) outside |= (x[a] + r <= 0) || (x[a] - r >= volume_[a]);
@@ -257,6 +269,12 @@ void GranularFieldPostProcessor::calculateFields() {
     const auto pieces = detail::ballSplitVolumes(r, d, split);
     const Real invV = 1 / detail::ballVolume(r);
     for (int b = 0; b < 8; ++b) weights_[p][b] = pieces[b] * invV;
+  }
+  if (firstNonFinite < n) {
+    const size_t id = gbs.idOfDense(firstNonFinite);
+    throw std::runtime_error(std::string(where) + ": particle id " + std::to_string(id) +
+                             " has a non-finite state (position " + detail::formatValue(pos[firstNonFinite]) +
+                             ", velocity " + detail::formatValue(vel[firstNonFinite]) + "); fields not computed");
   }
   if (firstTooLarge < n) {
     const size_t id = gbs.idOfDense(firstTooLarge);
@@ -299,8 +317,6 @@ void GranularFieldPostProcessor::calculateFields() {
       default: break;
     }
   }
-  const auto& vel = gbs.velocities();
-  const auto& masses = gbs.masses();
   const size_t numCustom = customData.size();
   const size_t layerSize = size_t(nx) * size_t(ny);
 
@@ -467,7 +483,7 @@ void GranularFieldStepListener::post(const TimeStamp&) {
   if (numSteps_ % every_ != 0) return;
   try {
     gpp_->calculateFields();
-  } catch (const std::invalid_argument& e) {
+  } catch (const std::exception& e) {  // too-large particle, removed buffer, non-finite particle state
     Logger::error(std::string("GranularFieldStepListener: fields not computed at step ") + std::to_string(numSteps_) +
                   ": " + e.what());
     return;

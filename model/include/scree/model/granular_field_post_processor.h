@@ -23,7 +23,9 @@
 //   SOLID_VOLUME_FRACTION  1 component   phi_ijk = sum V_p w_p / V_vox (packing density)      dimensionless
 //   KINETIC_STRESS         6 components  s_ijk = sum m_p w_p (v_p - v_ijk)(v_p - v_ijk)^T / V_vox   Pa
 //                          (the streaming/kinetic part of the stress from velocity fluctuations, positive
-//                          in compression as in the granular coarse-graining literature)
+//                          in compression as in the granular coarse-graining literature; computed as
+//                          (sum m_p w_p v_p v_p^T - m_ijk v_ijk v_ijk^T) / V_vox, so its absolute rounding
+//                          error is ~1e-16 m_ijk |v|^2 / V_vox)
 // Dependencies are added automatically: VELOCITY adds MASS and MOMENTUM; KINETIC_STRESS adds VELOCITY.
 //
 // Data layout (getFieldData()): one contiguous array of numVoxels() * numComponents() Reals, voxel-major,
@@ -146,8 +148,9 @@ class GranularFieldPostProcessor {
 
   // ---- fields -----------------------------------------------------------------------------------------------
   /// Adds a field and the fields it depends on. Adding a type (or, for CUSTOM, a buffer name) that is already
-  /// present keeps the existing field and returns it. A null field, or a custom field whose buffer does not
-  /// exist in the GranularBodySystem, throws std::invalid_argument.
+  /// present keeps the existing field and returns it. A null field, a field already added to another
+  /// post-processor, or a custom field whose buffer does not exist in the GranularBodySystem or whose name is a
+  /// built-in field's name, throws std::invalid_argument.
   GranularFieldRef addField(GranularFieldRef field);
   /// Shorthand for the built-in types (not CUSTOM).
   GranularFieldRef addField(GranularField::Type type);
@@ -164,7 +167,9 @@ class GranularFieldPostProcessor {
   /// Computes every added field from the particles' current state. Refuses (std::invalid_argument naming the
   /// particle id, its diameter and the smallest voxel side; every field unchanged) when a particle that reaches
   /// into the cuboid has a diameter larger than the smallest voxel side (relative tolerance 1e-12), and when a
-  /// custom field's buffer has been removed from the GranularBodySystem.
+  /// custom field's buffer has been removed from the GranularBodySystem. A live particle with a non-finite
+  /// position, velocity or mass (a blown-up simulation) throws std::runtime_error naming its id instead of
+  /// spreading NaN into the fields (fields unchanged).
   void calculateFields();
   /// Particles that contributed to the last calculateFields() (at least partly inside the cuboid).
   size_t getNumParticlesInside() const { return numInside_; }
@@ -203,8 +208,9 @@ class GranularFieldPostProcessor {
 using GranularFieldPostProcessorRef = std::shared_ptr<GranularFieldPostProcessor>;
 
 /// Step listener (post stage) that runs calculateFields() every N-th step and then calls an optional callback
-/// (e.g. to export). A refused configuration (a particle too large for the voxels) is logged as an error once
-/// per calculation and skipped; the step is not interrupted.
+/// (e.g. to export). A calculation that calculateFields() refuses (a particle too large for the voxels, a
+/// removed custom buffer, a non-finite particle) is logged as an error and skipped; the step is not
+/// interrupted.
 class GranularFieldStepListener : public StepEventListener {
  public:
   using Callback = std::function<void(const GranularFieldPostProcessor&, size_t stepIndex)>;
