@@ -9,6 +9,8 @@
 #include "scree/core/logger.h"
 #include "scree/core/material.h"
 #include "scree/core/math.h"
+#include "scree/core/parallel.h"
+#include "scree/core/particle_contact.h"
 #include "scree/core/property_container.h"
 #include "scree/core/rigid_body.h"
 #include "scree/collide/execute_filters.h"

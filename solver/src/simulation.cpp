@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "body_access.h"
+#include "granular_stage.h"
 #include "integrator.h"
 #include "scree/collide/narrowphase.h"
 #include "scree/core/errors.h"
@@ -90,6 +91,9 @@ struct Simulation::Impl {
   // Touching pairs of the last step (sorted) with their geometries, for impact/separation events.
   std::vector<std::pair<uint64_t, std::pair<Geometry*, Geometry*>>> prevPairs, curPairs;
   bool warnedSolveType = false;
+  // Particle path (granular_stage.h); granularStep: the particle system is in this step (destroys deferred).
+  detail::GranularStage granular;
+  bool granularStep = false;
 
   const CacheEntry* find(uint64_t pair, uint32_t feature) const {
     CacheEntry key{pair, feature, 0, Vec3::Zero(), 0};
@@ -317,6 +321,21 @@ void Simulation::runCollide() {
     materials_.resolve(m0, m1, c.material(), &fm);
     c.setFrictionModel(fm);
   }
+
+  // Particles: their own grid against each other and every geometry. Destroys are deferred from here to the
+  // end of the step so that dense indices held by the contacts stay valid through the listeners.
+  impl_->granularStep = impl_->granular.active(granular_);
+  if (impl_->granularStep) {
+    impl_->granular.collide(granular_, space_.getGeometries(), h_);
+    granular_.beginDeferral();
+  }
+}
+
+const std::vector<ParticleContact>& Simulation::getParticleParticleContacts() const {
+  return impl_->granular.particleParticleContacts();
+}
+const std::vector<ParticleContact>& Simulation::getParticleGeometryContacts() const {
+  return impl_->granular.particleGeometryContacts();
 }
 
 void Simulation::runContactEvents() {
@@ -620,19 +639,41 @@ void Simulation::buildRows() {
   st.numWarmStarted = numWarm;
   stats_.numContacts = contacts_.size();
   stats_.numContactPoints = numPoints;
+
+  if (m.granularStep) {
+    m.granular.buildRows(granular_, materials_, solver_, m.sb, [this](const RigidBody* b) { return solverIndex(b); },
+                         gravity_, h);
+    stats_.numParticleContacts = m.granular.numUnits();
+  }
 }
 
 void Simulation::solve() {
   Impl& m = *impl_;
-  if (m.rows.empty()) {
+  const bool particles = m.granularStep && m.granular.hasUnits();
+  if (m.rows.empty() && !particles) {
     solver_.stats().numIterations = 0;
     solver_.stats().lastResidual = 0;
     return;
   }
-  PgsSolver::prepare(m.rows, m.sb);
-  solver_.stats().lastResidual = PgsSolver::iterate(m.rows, m.sb, solver_.getNumIterations());
-  solver_.stats().numIterations = size_t(solver_.getNumIterations());
-  if (solver_.getUseShockPropagation() && !m.contactRanges.empty()) {
+  const int iterations = solver_.getNumIterations();
+  Real residual = 0;
+  if (!m.rows.empty()) PgsSolver::prepare(m.rows, m.sb);
+  if (particles) m.granular.prepare(granular_, m.sb);
+  if (particles && m.granular.coupled() && !m.rows.empty()) {
+    // Particles touch dynamic bodies: interleave one rigid sweep and one particle sweep per iteration so that
+    // each side sees the other's impulses.
+    for (int it = 0; it < iterations; ++it) {
+      residual = PgsSolver::iterate(m.rows, m.sb, 1);
+      residual = std::max(residual, m.granular.sweep(granular_, m.sb, it % 2 == 1));
+    }
+  } else {
+    if (!m.rows.empty()) residual = PgsSolver::iterate(m.rows, m.sb, iterations);
+    if (particles)
+      for (int it = 0; it < iterations; ++it) residual = std::max(residual, m.granular.sweep(granular_, m.sb, it % 2 == 1));
+  }
+  solver_.stats().lastResidual = residual;
+  solver_.stats().numIterations = size_t(iterations);
+  if (!m.rows.empty() && solver_.getUseShockPropagation() && !m.contactRanges.empty()) {
     buildShockOrder();
     PgsSolver::shockPass(m.rows, m.sb, m.shock, solver_.getNumShockIterations());
   }
@@ -723,6 +764,11 @@ void Simulation::integrate() {
     }
     b.clearForces();
   }
+  if (m.granularStep) {
+    const size_t before = report_.messages.size();
+    m.granular.integrate(granular_, h, report_.nonFiniteParticles, report_.messages, time_);
+    for (size_t k = before; k < report_.messages.size(); ++k) Logger::error(report_.messages[k]);
+  }
 }
 
 void Simulation::storeContactResults() {
@@ -745,6 +791,10 @@ void Simulation::storeContactResults() {
   std::sort(m.nextCache.begin(), m.nextCache.end());
   std::swap(m.cache, m.nextCache);
   for (const auto& r : m.ranges) r.c->storeResult(m.rows.data() + r.begin, m.rowDofs.data() + r.begin, r.count, h_);
+  if (m.granularStep) {
+    m.granular.storeResults(granular_, h_);
+    granular_.endDeferral();
+  }
 }
 
 void Simulation::checkFinite() {

@@ -19,6 +19,7 @@
 #include "scree/core/granular_body_system.h"
 #include "scree/core/listeners.h"
 #include "scree/core/material.h"
+#include "scree/core/particle_contact.h"
 #include "scree/core/rigid_body.h"
 #include "scree/solver/constraint.h"
 #include "scree/solver/solver.h"
@@ -32,6 +33,7 @@ struct StepStats {
   size_t numBroadphasePairs = 0;
   size_t numContacts = 0;
   size_t numContactPoints = 0;
+  size_t numParticleContacts = 0;  ///< particle-particle plus solved particle-geometry contact points
 };
 
 /// Problems found in the last step.
@@ -39,7 +41,9 @@ struct StepReport {
   /// Ids and names of bodies whose state became non-finite (they were restored and stopped).
   std::vector<uint32_t> nonFiniteBodies;
   std::vector<std::string> messages;
-  bool ok() const { return nonFiniteBodies.empty(); }
+  /// Ids of particles whose state became non-finite (they kept their last position and were stopped).
+  std::vector<size_t> nonFiniteParticles;
+  bool ok() const { return nonFiniteBodies.empty() && nonFiniteParticles.empty(); }
 };
 
 class Simulation {
@@ -89,6 +93,10 @@ class Simulation {
 
   /// Contacts of the last step, with the forces the solver applied (sensor contacts included, no force).
   const std::vector<GeometryContact>& getContacts() const { return contacts_; }
+  /// Particle contacts of the last step with their forces (dense particle indices of that step, see
+  /// ParticleContact): particle-particle, and particle-geometry (sensor contacts included, flagged).
+  const std::vector<ParticleContact>& getParticleParticleContacts() const;
+  const std::vector<ParticleContact>& getParticleGeometryContacts() const;
   const StepStats& getStepStats() const { return stats_; }
   const StepReport& getLastStepReport() const { return report_; }
 

@@ -1,0 +1,61 @@
+// ParticleCollider: contacts of GranularBodySystem particles with each other and with geometries.
+//
+// Broadphase: a hashed uniform grid over the particles, cell size = largest particle diameter + the pair
+// margin, so every touching or speculative pair lies in the same or an adjacent cell (27-cell stencil). The
+// cells are built by a counting sort in dense order (deterministic); candidate pairs are found in parallel over
+// fixed chunks of particles, each chunk writing its own buffer, and the buffers are concatenated in chunk order,
+// so the contact list is the same for any number of threads.
+//
+// Particle pairs: analytic sphere-sphere. A pair is a (speculative) contact when its gap is below
+//   margin_ab = h |v_a - v_b| + contactMargin,
+// capped at one largest diameter (the grid's reach): particles closing faster than that relative to each other
+// may miss one step of speculative contact (particle-geometry contacts have no such cap).
+//
+// Particles vs geometries: every collision-enabled geometry in the list (all shapes, height fields, sensors)
+// is tested with the geometry narrowphase (collideGeometries) using a per-thread sphere geometry; the margin is
+// h |v_particle - v_body| + contactMargin, so fast particles get speculative contacts against thin walls. A
+// geometry's candidates come from the grid cells its bounding box covers (or all particles when that is fewer).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "scree/collide/geometry.h"
+#include "scree/core/granular_body_system.h"
+#include "scree/core/particle_contact.h"
+
+namespace scree {
+
+class ParticleCollider {
+ public:
+  ParticleCollider();
+  ~ParticleCollider();
+
+  /// Distance added to every pair's speculative margin, m (default 1e-3, as Space).
+  void setContactMargin(Real m) { margin_ = m; }
+  Real getContactMargin() const { return margin_; }
+
+  /// Finds the contacts of all live particles of `ps` (dense entries flagged dead are skipped) with each other
+  /// and with `geometries` (world transforms current). h is the time step (speculative margins).
+  void collide(const GranularBodySystem& ps, const std::vector<GeometryRef>& geometries, Real h);
+
+  /// Particle-particle contacts (b >= 0), ordered by a, then b.
+  const std::vector<ParticleContact>& getParticleParticleContacts() const { return pp_; }
+  std::vector<ParticleContact>& getParticleParticleContacts() { return pp_; }
+  /// Particle-geometry contacts (b = -1), sensors included (sensor = true), ordered by geometry then a.
+  const std::vector<ParticleContact>& getParticleGeometryContacts() const { return pg_; }
+  std::vector<ParticleContact>& getParticleGeometryContacts() { return pg_; }
+
+  /// A permutation (for GranularBodySystem::reorder) that sorts particles along the grid (cells in z, y, x
+  /// order), so neighbours in space are near in memory. Uses the grid of the last collide().
+  std::vector<uint32_t> localityOrder(const GranularBodySystem& ps) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  Real margin_ = 1e-3;
+  std::vector<ParticleContact> pp_, pg_;
+};
+
+}  // namespace scree

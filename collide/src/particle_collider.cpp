@@ -1,0 +1,259 @@
+#include "scree/collide/particle_collider.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "scree/collide/narrowphase.h"
+#include "scree/collide/shapes.h"
+#include "scree/core/rigid_body.h"
+
+#ifdef SCREE_WITH_OPENMP
+#include <omp.h>
+#endif
+
+namespace scree {
+
+namespace {
+// Particles per work chunk. Chunks, not threads, own output buffers: the merged order is independent of the
+// thread count.
+constexpr size_t kChunk = 512;
+
+inline uint64_t hashCell(int64_t x, int64_t y, int64_t z) {
+  return uint64_t(x) * 73856093ull ^ uint64_t(y) * 19349663ull ^ uint64_t(z) * 83492791ull;
+}
+int threadIndex() {
+#ifdef SCREE_WITH_OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+int maxThreads() {
+#ifdef SCREE_WITH_OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+}  // namespace
+
+struct ParticleCollider::Impl {
+  Real cell = 1, invCell = 1;
+  size_t tableMask = 0;
+  std::vector<int32_t> cx, cy, cz;          // [size()] cell coordinates per dense particle
+  std::vector<uint32_t> bucketOf;           // [size()] hash bucket per particle
+  std::vector<uint32_t> bucketStart;        // [table + 1] prefix sums
+  std::vector<uint32_t> sorted;             // particles by bucket, dense order within a bucket
+  std::vector<std::vector<ParticleContact>> chunkOut;  // per chunk
+  // Per-thread probe sphere for the geometry narrowphase.
+  std::vector<std::shared_ptr<Sphere>> probeShapes;
+  std::vector<std::unique_ptr<Geometry>> probes;
+  std::vector<std::vector<ContactPoint>> scratch;
+  std::vector<uint32_t> candidates;
+
+  template <class F>
+  void forCell(int64_t x, int64_t y, int64_t z, F&& f) const {
+    const size_t b = hashCell(x, y, z) & tableMask;
+    for (uint32_t k = bucketStart[b]; k < bucketStart[b + 1]; ++k) {
+      const uint32_t j = sorted[k];
+      if (cx[j] == x && cy[j] == y && cz[j] == z) f(j);
+    }
+  }
+};
+
+ParticleCollider::ParticleCollider() : impl_(std::make_unique<Impl>()) {}
+ParticleCollider::~ParticleCollider() = default;
+
+void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<GeometryRef>& geometries, Real h) {
+  Impl& m = *impl_;
+  pp_.clear();
+  pg_.clear();
+  const size_t n = ps.size();
+  if (n == 0) return;
+  const auto& x = ps.positions();
+  const auto& v = ps.velocities();
+  const auto& r = ps.radii();
+
+  // ---- grid --------------------------------------------------------------------------------------------------
+  Real maxR = 0, maxV = 0;
+  for (size_t i = 0; i < n; ++i) {
+    maxR = std::max(maxR, r[i]);
+    maxV = std::max(maxV, v[i].squaredNorm());
+  }
+  maxV = std::sqrt(maxV);
+  // Pair margin reach: relative speed of two particles is at most 2 maxV; capped at one diameter (see header).
+  const Real reach = std::min(2 * maxV * h + margin_, 2 * maxR);
+  m.cell = 2 * maxR + reach;
+  m.invCell = 1.0 / m.cell;
+  size_t table = 64;
+  while (table < 2 * n) table <<= 1;
+  m.tableMask = table - 1;
+  m.cx.resize(n);
+  m.cy.resize(n);
+  m.cz.resize(n);
+  m.bucketOf.resize(n);
+#pragma omp parallel for schedule(static)
+  for (size_t i = 0; i < n; ++i) {
+    m.cx[i] = int32_t(std::floor(x[i].x() * m.invCell));
+    m.cy[i] = int32_t(std::floor(x[i].y() * m.invCell));
+    m.cz[i] = int32_t(std::floor(x[i].z() * m.invCell));
+    m.bucketOf[i] = uint32_t(hashCell(m.cx[i], m.cy[i], m.cz[i]) & m.tableMask);
+  }
+  m.bucketStart.assign(table + 1, 0);
+  for (size_t i = 0; i < n; ++i)
+    if (ps.isAliveDense(i)) ++m.bucketStart[m.bucketOf[i] + 1];
+  for (size_t b = 0; b < table; ++b) m.bucketStart[b + 1] += m.bucketStart[b];
+  m.sorted.resize(m.bucketStart[table]);
+  {
+    std::vector<uint32_t>& fill = m.candidates;  // reuse as a cursor array
+    fill.assign(m.bucketStart.begin(), m.bucketStart.end() - 1);
+    for (size_t i = 0; i < n; ++i)
+      if (ps.isAliveDense(i)) m.sorted[fill[m.bucketOf[i]]++] = uint32_t(i);
+  }
+
+  // ---- particle pairs ----------------------------------------------------------------------------------------
+  const size_t numChunks = (n + kChunk - 1) / kChunk;
+  if (m.chunkOut.size() < numChunks) m.chunkOut.resize(numChunks);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (size_t c = 0; c < numChunks; ++c) {
+    auto& out = m.chunkOut[c];
+    out.clear();
+    const size_t end = std::min(n, (c + 1) * kChunk);
+    for (size_t i = c * kChunk; i < end; ++i) {
+      if (!ps.isAliveDense(i)) continue;
+      const Vec3 xi = x[i];
+      const Real ri = r[i];
+      const size_t firstNew = out.size();
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx)
+            m.forCell(int64_t(m.cx[i]) + dx, int64_t(m.cy[i]) + dy, int64_t(m.cz[i]) + dz, [&](uint32_t j) {
+              if (j <= i) return;
+              const Vec3 d = xi - x[j];
+              const Real dist2 = d.squaredNorm();
+              const Real pairMargin = std::min(h * (v[i] - v[j]).norm() + margin_, reach);
+              const Real lim = ri + r[j] + pairMargin;
+              if (dist2 >= lim * lim) return;
+              const Real dist = std::sqrt(dist2);
+              ParticleContact pc;
+              pc.a = uint32_t(i);
+              pc.b = int32_t(j);
+              // Coincident centres: any unit normal will do; pick +z so the result is deterministic.
+              pc.normal = dist > 1e-12 * (ri + r[j]) ? Vec3(d / dist) : Vec3::UnitZ();
+              pc.depth = ri + r[j] - dist;
+              // Midway between the two surfaces.
+              pc.point = xi - pc.normal * (ri - 0.5 * pc.depth);
+              out.push_back(pc);
+            });
+      // Order this particle's contacts by partner so the list does not depend on the hash layout.
+      std::sort(out.begin() + long(firstNew), out.end(),
+                [](const ParticleContact& p, const ParticleContact& q) { return p.b < q.b; });
+    }
+  }
+  size_t total = 0;
+  for (size_t c = 0; c < numChunks; ++c) total += m.chunkOut[c].size();
+  pp_.reserve(total);
+  for (size_t c = 0; c < numChunks; ++c) pp_.insert(pp_.end(), m.chunkOut[c].begin(), m.chunkOut[c].end());
+
+  // ---- particles vs geometries -------------------------------------------------------------------------------
+  const int nt = maxThreads();
+  if (int(m.probes.size()) < nt) {
+    for (int t = int(m.probes.size()); t < nt; ++t) {
+      m.probeShapes.push_back(std::make_shared<Sphere>(1.0));
+      m.probes.push_back(std::make_unique<Geometry>(m.probeShapes.back(), "particle probe"));
+    }
+    m.scratch.resize(size_t(nt));
+  }
+  Aabb cloud;
+  for (size_t i = 0; i < n; ++i)
+    if (ps.isAliveDense(i)) cloud.expand(x[i]);
+  cloud.inflate(maxR + maxV * h + margin_);
+  for (const GeometryRef& gref : geometries) {
+    const Geometry& g = *gref;
+    if (!g.getEnableCollisions()) continue;
+    if (!hasCollider(Shape::SPHERE, g.getShape()->getType())) continue;
+    const RigidBody* body = g.getRigidBody();
+    const Vec3 vBody = body ? body->getVelocity() : Vec3::Zero();
+    const Real bodyReach = body ? (body->getVelocity().norm() + body->getAngularVelocity().norm() *
+                                                                     0.5 * g.getBoundingBox().extent().norm()) * h
+                                : 0.0;
+    Aabb box = g.getBoundingBox();
+    box.inflate(maxR + maxV * h + bodyReach + margin_);
+    if (!box.overlaps(cloud)) continue;
+    // Candidates: cells the clipped box covers, or every particle when that is cheaper.
+    Aabb clip;
+    clip.lo = box.lo.cwiseMax(cloud.lo);
+    clip.hi = box.hi.cwiseMin(cloud.hi);
+    const Vec3 cells = ((clip.hi - clip.lo) * m.invCell).array() + 2.0;
+    auto& cand = m.candidates;
+    cand.clear();
+    if (cells.x() * cells.y() * cells.z() < Real(n)) {
+      const int64_t x0 = int64_t(std::floor(clip.lo.x() * m.invCell)), x1 = int64_t(std::floor(clip.hi.x() * m.invCell));
+      const int64_t y0 = int64_t(std::floor(clip.lo.y() * m.invCell)), y1 = int64_t(std::floor(clip.hi.y() * m.invCell));
+      const int64_t z0 = int64_t(std::floor(clip.lo.z() * m.invCell)), z1 = int64_t(std::floor(clip.hi.z() * m.invCell));
+      for (int64_t cz = z0; cz <= z1; ++cz)
+        for (int64_t cy = y0; cy <= y1; ++cy)
+          for (int64_t cx = x0; cx <= x1; ++cx) m.forCell(cx, cy, cz, [&](uint32_t j) { cand.push_back(j); });
+      std::sort(cand.begin(), cand.end());
+    } else {
+      for (size_t i = 0; i < n; ++i)
+        if (ps.isAliveDense(i)) cand.push_back(uint32_t(i));
+    }
+    if (cand.empty()) continue;
+    const Aabb gBox = g.getBoundingBox();
+    const size_t nc = cand.size();
+    const size_t numGChunks = (nc + kChunk - 1) / kChunk;
+    if (m.chunkOut.size() < numGChunks) m.chunkOut.resize(numGChunks);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (size_t c = 0; c < numGChunks; ++c) {
+      auto& out = m.chunkOut[c];
+      out.clear();
+      const int t = threadIndex();
+      Geometry& probe = *m.probes[size_t(t)];
+      Sphere& probeShape = *m.probeShapes[size_t(t)];
+      auto& pts = m.scratch[size_t(t)];
+      const size_t end = std::min(nc, (c + 1) * kChunk);
+      for (size_t k = c * kChunk; k < end; ++k) {
+        const uint32_t i = cand[k];
+        const Real pm = h * (v[i] - vBody).norm() + bodyReach + margin_;
+        Aabb pb;
+        pb.expand(x[i]);
+        pb.inflate(r[i] + pm);
+        if (!pb.overlaps(gBox)) continue;
+        probeShape.setRadius(r[i]);
+        probe.setPosition(x[i]);
+        pts.clear();
+        collideGeometries(probe, g, pm, pts);
+        for (const ContactPoint& p : pts) {
+          ParticleContact pc;
+          pc.a = i;
+          pc.b = -1;
+          pc.geometry = &g;
+          pc.point = p.point;
+          pc.normal = p.normal;
+          pc.depth = p.depth;
+          pc.featureId = p.featureId;
+          pc.sensor = g.isSensor();
+          out.push_back(pc);
+        }
+      }
+    }
+    for (size_t c = 0; c < numGChunks; ++c) pg_.insert(pg_.end(), m.chunkOut[c].begin(), m.chunkOut[c].end());
+  }
+}
+
+std::vector<uint32_t> ParticleCollider::localityOrder(const GranularBodySystem& ps) const {
+  const Impl& m = *impl_;
+  const size_t n = ps.size();
+  std::vector<uint32_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = uint32_t(i);
+  if (m.cx.size() != n) return order;
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    if (m.cz[a] != m.cz[b]) return m.cz[a] < m.cz[b];
+    if (m.cy[a] != m.cy[b]) return m.cy[a] < m.cy[b];
+    return m.cx[a] < m.cx[b];
+  });
+  return order;
+}
+
+}  // namespace scree

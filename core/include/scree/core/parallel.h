@@ -1,0 +1,14 @@
+// Thread control for Scree's parallel stages (OpenMP when built with SCREE_WITH_OPENMP, serial otherwise).
+// Parallel stages are written so that their results do not depend on the number of threads (work split into
+// fixed chunks, per-chunk outputs merged in chunk order, graph-coloured solver sweeps): setNumThreads changes
+// speed, not results.
+#pragma once
+
+namespace scree {
+
+/// Threads used by the parallel stages (>= 1; values < 1 select the OpenMP default). Without OpenMP a no-op.
+void setNumThreads(int n);
+/// Threads the parallel stages will use (1 without OpenMP).
+int getNumThreads();
+
+}  // namespace scree

@@ -1,0 +1,487 @@
+#include "granular_stage.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <sstream>
+
+#include "scree/collide/shapes.h"
+#include "scree/solver/spook.h"
+
+namespace scree::detail {
+
+namespace {
+// Parallel loops below this many items run serially (the fork/join would cost more than the work); results
+// are the same either way.
+constexpr size_t kParallelMin = 2048;
+constexpr uint8_t kSerial = 255;
+constexpr int kMaxColors = 64;
+
+uint64_t slotKey(size_t id) { return uint64_t(uint32_t(id & 0xffffffffu)); }
+
+Real rollingRadiusOf(const Geometry* g) {
+  const Shape* s = g->getShape().get();
+  switch (s->getType()) {
+    case Shape::SPHERE: return static_cast<const Sphere*>(s)->getRadius();
+    case Shape::CYLINDER: return static_cast<const Cylinder*>(s)->getRadius();
+    case Shape::CAPSULE: return static_cast<const Capsule*>(s)->getRadius();
+    default: return 0;
+  }
+}
+
+// Contact parameters resolved once per material pair per step.
+struct PairParams {
+  Real eN = 0, a = 0, upsilon = 1;  // SPOOK normal row
+  Real eT = 0;                      // friction-row regularisation
+  Real mu = 0, rest = 0, rolling = 0, adhF = 0, adhO = 0;
+};
+PairParams makeParams(const SurfaceParameters& s, Real h) {
+  PairParams p;
+  const SpookCoefficients co = spookHolonomic(h, 1.0 / s.getYoungsModulus(), s.getDamping());
+  p.eN = co.e;
+  p.a = co.a;
+  p.upsilon = co.upsilon;
+  p.eT = spookVelocityRegularisation(h, s.getSurfaceViscosity());
+  p.mu = s.getFrictionCoefficient();
+  p.rest = s.getRestitution();
+  p.rolling = s.getRollingResistanceCoefficient();
+  p.adhF = s.getAdhesiveForce();
+  p.adhO = s.getAdhesiveOverlap();
+  return p;
+}
+}  // namespace
+
+const GranularStage::CacheEntry* GranularStage::find(const std::vector<CacheEntry>& cache, uint64_t key,
+                                                     uint32_t feature) const {
+  CacheEntry probe{key, feature, 0, Vec3::Zero(), Vec3::Zero()};
+  auto it = std::lower_bound(cache.begin(), cache.end(), probe);
+  if (it != cache.end() && it->key == key && it->feature == feature) return &*it;
+  return nullptr;
+}
+
+void GranularStage::collide(GranularBodySystem& ps, const std::vector<GeometryRef>& geometries, Real h) {
+  // Reorder at the start of a step, before any dense index is handed out for this step.
+  if (ps.size() > 0 && stepCount_ > 0 && stepCount_ % kReorderInterval == 0 && !ps.isDeferring())
+    ps.reorder(collider_.localityOrder(ps));
+  ++stepCount_;
+  collider_.collide(ps, geometries, h);
+}
+
+void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& materials, const Solver& solver,
+                              std::vector<SolverBodyState>& bodies,
+                              const std::function<int(const RigidBody*)>& solverIndexOf, const Vec3& gravity,
+                              Real h) {
+  const size_t n = ps.size();
+  auto& pp = collider_.getParticleParticleContacts();
+  auto& pg = collider_.getParticleGeometryContacts();
+  const auto& x = ps.positions();
+  auto& v = ps.velocities();
+  auto& w = ps.angularVelocities();
+  const auto& r = ps.radii();
+  const auto& invM = ps.invMasses();
+  const auto& matIdx = ps.materialIndices();
+  const auto& matTable = ps.getMaterialTable();
+
+  invInertia_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Real m = ps.masses()[i];
+    invInertia_[i] = invM[i] > 0 ? 1.0 / (0.4 * m * r[i] * r[i]) : 0.0;
+  }
+
+  // ---- material pairs ----------------------------------------------------------------------------------------
+  const size_t K = matTable.size();
+  std::vector<PairParams> ppParams(K * K);
+  for (size_t i = 0; i < K; ++i)
+    for (size_t j = 0; j < K; ++j) {
+      SurfaceParameters s;
+      materials.resolve(matTable[i].get(), matTable[j].get(), s, nullptr);
+      ppParams[i * K + j] = makeParams(s, h);
+    }
+  // Particle-geometry: (particle material, geometry material) pairs met this step, plus body indices.
+  std::vector<std::pair<std::pair<uint32_t, const Material*>, PairParams>> pgParams;
+  std::vector<uint32_t> pgParam(pg.size());
+  std::vector<int32_t> pgBody(pg.size());
+  std::vector<uint32_t> pgUnit(pg.size());
+  size_t numUnits = pp.size();
+  {
+    const Geometry* lastGeom = nullptr;
+    int lastBody = -1;
+    for (size_t k = 0; k < pg.size(); ++k) {
+      const ParticleContact& c = pg[k];
+      if (c.sensor) continue;
+      const Material* gm = c.geometry->getMaterial().get();
+      const std::pair<uint32_t, const Material*> key{matIdx[c.a], gm};
+      size_t e = 0;
+      while (e < pgParams.size() && pgParams[e].first != key) ++e;
+      if (e == pgParams.size()) {
+        SurfaceParameters s;
+        materials.resolve(matTable[key.first].get(), gm, s, nullptr);
+        pgParams.push_back({key, makeParams(s, h)});
+      }
+      pgParam[k] = uint32_t(e);
+      if (c.geometry != lastGeom) {
+        lastGeom = c.geometry;
+        lastBody = solverIndexOf(c.geometry->getRigidBody());
+      }
+      pgBody[k] = lastBody;
+      pgUnit[k] = uint32_t(numUnits++);
+    }
+  }
+
+  // ---- units -------------------------------------------------------------------------------------------------
+  scratchUnits_.resize(numUnits);
+  const Real threshold = solver.getRestitutionThreshold();
+  const Real maxRecovery = solver.getMaxPenetrationRecoverySpeed();
+  const bool warm = solver.getUseWarmStarting();
+  const Real gravityNorm = gravity.norm();
+  (void)gravityNorm;
+
+  // Normal row from the pair parameters; vn0 is the normal relative velocity at the start of the step.
+  auto normalRow = [&](Unit& u, const PairParams& p, Real depth, Real vn0, Real nAdh) {
+    const Real adhF = p.adhF / nAdh;
+    if (depth < 0 && adhF <= 0) {
+      u.rhsN = depth / h;  // speculative: may close the gap, no force before that
+      u.eN = 0;
+      u.loN = 0;
+      return;
+    }
+    const Real g = (adhF > 0 ? p.adhO : 0.0) - depth;
+    Real bias = -p.a * g;
+    if (maxRecovery > 0) bias = std::min(bias, maxRecovery);
+    u.rhsN = bias + p.upsilon * vn0;
+    u.eN = p.eN;
+    u.loN = adhF > 0 ? (std::isinf(adhF) ? -1e300 : -adhF * h) : 0.0;
+    if (-vn0 > threshold) u.rhsN = std::max(u.rhsN, p.rest * -vn0);
+  };
+  auto effMass = [](Real im, Real ii, const Vec3& r, const Vec3& d) { return im + ii * r.cross(d).squaredNorm(); };
+  auto bodyEff = [](const SolverBodyState& b, const Vec3& r, const Vec3& d) {
+    const Vec3 c = r.cross(d);
+    return b.invMass + c.dot(b.invInertia * c);
+  };
+
+#pragma omp parallel for schedule(static) if (numUnits > kParallelMin)
+  for (size_t k = 0; k < pp.size() + pg.size(); ++k) {
+    const bool isPP = k < pp.size();
+    const ParticleContact& c = isPP ? pp[k] : pg[k - pp.size()];
+    if (!isPP && c.sensor) continue;
+    Unit& u = scratchUnits_[isPP ? k : pgUnit[k - pp.size()]];
+    u = Unit{};
+    u.a = c.a;
+    u.b = isPP ? c.b : -1;
+    u.body = isPP ? -1 : pgBody[k - pp.size()];
+    u.src = uint32_t(isPP ? k : k - pp.size());
+    u.n = c.normal;
+    orthonormalBasis(u.n, u.t1, u.t2);
+    const uint32_t a = c.a;
+    const bool deadPair = !ps.isAliveDense(a) || (isPP && !ps.isAliveDense(size_t(c.b)));
+    if (deadPair) continue;  // inert unit: all gains zero
+    u.ra = c.point - x[a];
+    const PairParams& p = isPP ? ppParams[matIdx[a] * K + matIdx[size_t(c.b)]] : pgParams[pgParam[k - pp.size()]].second;
+    // Relative velocity at the point at the start of the step, and effective masses.
+    Vec3 vrel = v[a] + w[a].cross(u.ra);
+    Real kn = effMass(invM[a], invInertia_[a], u.ra, u.n);
+    Real kt1 = effMass(invM[a], invInertia_[a], u.ra, u.t1);
+    Real kt2 = effMass(invM[a], invInertia_[a], u.ra, u.t2);
+    Real kr = invInertia_[a];
+    Real rollR = r[a];
+    if (isPP) {
+      const size_t b = size_t(c.b);
+      u.rb = c.point - x[b];
+      vrel -= v[b] + w[b].cross(u.rb);
+      kn += effMass(invM[b], invInertia_[b], u.rb, u.n);
+      kt1 += effMass(invM[b], invInertia_[b], u.rb, u.t1);
+      kt2 += effMass(invM[b], invInertia_[b], u.rb, u.t2);
+      kr += invInertia_[b];
+      rollR = r[a] * r[b] / (r[a] + r[b]);
+    } else {
+      const RigidBody* body = c.geometry->getRigidBody();
+      if (u.body >= 0) {
+        const SolverBodyState& sb = bodies[size_t(u.body)];
+        u.rb = c.point - body->getCmPosition();
+        vrel -= body->getVelocity() + body->getAngularVelocity().cross(u.rb);
+        kn += bodyEff(sb, u.rb, u.n);
+        kt1 += bodyEff(sb, u.rb, u.t1);
+        kt2 += bodyEff(sb, u.rb, u.t2);
+        // Rolling rows act on the relative rotation: add the body's rotational compliance about the tangents
+        // (average of the two, the rows are solved as a disc).
+        kr += 0.5 * (u.t1.dot(sb.invInertia * u.t1) + u.t2.dot(sb.invInertia * u.t2));
+      }
+      const Real gr = rollingRadiusOf(c.geometry);
+      if (gr > 0) rollR = r[a] * gr / (r[a] + gr);
+    }
+    normalRow(u, p, c.depth, u.n.dot(vrel), 1.0);
+    u.kN = 1.0 / (kn + u.eN);
+    u.mu = p.mu;
+    u.eT = p.eT;
+    u.kT1 = 1.0 / (kt1 + u.eT);
+    u.kT2 = 1.0 / (kt2 + u.eT);
+    u.rollMu = p.rolling * rollR;
+    u.kR = kr > 0 ? 1.0 / (kr + u.eT) : 0.0;
+
+    // Warm start.
+    if (warm) {
+      const size_t idA = ps.idOfDense(a);
+      if (isPP) {
+        const uint64_t sa = slotKey(idA), sb = slotKey(ps.idOfDense(size_t(c.b)));
+        u.flip = sa > sb;
+        const CacheEntry* ce = find(ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
+        if (ce) {
+          const Real s = u.flip ? -1.0 : 1.0;
+          u.lN = std::max(ce->normal, u.loN);
+          u.lT1 = s * ce->friction.dot(u.t1);
+          u.lT2 = s * ce->friction.dot(u.t2);
+          u.lR1 = s * ce->rolling.dot(u.t1);
+          u.lR2 = s * ce->rolling.dot(u.t2);
+        }
+      } else {
+        const CacheEntry* ce = find(pgCache_, slotKey(idA) << 32 | c.geometry->getId(), c.featureId);
+        if (ce) {
+          u.lN = std::max(ce->normal, u.loN);
+          u.lT1 = ce->friction.dot(u.t1);
+          u.lT2 = ce->friction.dot(u.t2);
+          u.lR1 = ce->rolling.dot(u.t1);
+          u.lR2 = ce->rolling.dot(u.t2);
+        }
+      }
+    }
+  }
+
+  color(n);
+
+  // Free velocities.
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+  for (size_t i = 0; i < n; ++i)
+    if (invM[i] > 0) v[i] += h * gravity;
+}
+
+void GranularStage::color(size_t numParticles) {
+  // Greedy colouring in list order: a unit takes the lowest colour free at both of its particles. Units that
+  // touch a dynamic rigid body (shared by many units) go to the serial list, as do units beyond 63 colours.
+  const size_t nu = scratchUnits_.size();
+  used_.assign(numParticles, 0);
+  colorOf_.resize(nu);
+  std::vector<uint32_t> count(kMaxColors + 1, 0);
+  for (size_t k = 0; k < nu; ++k) {
+    const Unit& u = scratchUnits_[k];
+    if (u.body >= 0) {
+      colorOf_[k] = kSerial;
+      ++count[kMaxColors];
+      continue;
+    }
+    uint64_t mask = used_[u.a];
+    if (u.b >= 0) mask |= used_[size_t(u.b)];
+    if (mask == ~uint64_t(0)) {
+      colorOf_[k] = kSerial;
+      ++count[kMaxColors];
+      continue;
+    }
+    const int c = std::countr_one(mask);
+    colorOf_[k] = uint8_t(c);
+    ++count[size_t(c)];
+    used_[u.a] |= uint64_t(1) << c;
+    if (u.b >= 0) used_[size_t(u.b)] |= uint64_t(1) << c;
+  }
+  int numColors = 0;
+  for (int c = 0; c < kMaxColors; ++c)
+    if (count[size_t(c)] > 0) numColors = c + 1;
+  colorStart_.assign(size_t(numColors) + 1, 0);
+  for (int c = 0; c < numColors; ++c) colorStart_[size_t(c) + 1] = colorStart_[size_t(c)] + count[size_t(c)];
+  std::vector<uint32_t> cursor(colorStart_.begin(), colorStart_.end() - 1);
+  const uint32_t serialBegin = colorStart_.back();
+  uint32_t serialCursor = serialBegin;
+  units_.resize(nu);
+  serial_.clear();
+  for (size_t k = 0; k < nu; ++k) {
+    if (colorOf_[k] == kSerial) {
+      serial_.push_back(serialCursor);
+      units_[serialCursor++] = scratchUnits_[k];
+    } else {
+      units_[cursor[colorOf_[k]]++] = scratchUnits_[k];
+    }
+  }
+}
+
+void GranularStage::prepare(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies) {
+  auto& v = ps.velocities();
+  auto& w = ps.angularVelocities();
+  const auto& invM = ps.invMasses();
+  // Serial in unit order: warm-start impulses of different units may touch the same particle.
+  for (const Unit& u : units_) {
+    const Vec3 P = u.lN * u.n + u.lT1 * u.t1 + u.lT2 * u.t2;
+    const Vec3 T = u.lR1 * u.t1 + u.lR2 * u.t2;
+    if (P.isZero(0) && T.isZero(0)) continue;
+    v[u.a] += invM[u.a] * P;
+    w[u.a] += invInertia_[u.a] * (u.ra.cross(P) + T);
+    if (u.b >= 0) {
+      v[size_t(u.b)] -= invM[size_t(u.b)] * P;
+      w[size_t(u.b)] -= invInertia_[size_t(u.b)] * (u.rb.cross(P) + T);
+    } else if (u.body >= 0 && bodies[size_t(u.body)].invMass > 0) {
+      SolverBodyState& b = bodies[size_t(u.body)];
+      b.v -= b.invMass * P;
+      b.w -= b.invInertia * (u.rb.cross(P) + T);
+    }
+  }
+}
+
+void GranularStage::solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& w, const std::vector<Real>& invM,
+                              const std::vector<Real>& invI, std::vector<SolverBodyState>& bodies,
+                              Real& maxDelta) const {
+  const uint32_t a = u.a;
+  const int32_t b = u.b;
+  SolverBodyState* body = (b < 0 && u.body >= 0) ? &bodies[size_t(u.body)] : nullptr;
+  const bool bodyDyn = body && body->invMass > 0;
+  auto relVel = [&]() -> Vec3 {
+    Vec3 vr = v[a] + w[a].cross(u.ra);
+    if (b >= 0) vr -= v[size_t(b)] + w[size_t(b)].cross(u.rb);
+    else if (body) vr -= body->v + body->w.cross(u.rb);
+    return vr;
+  };
+  auto applyP = [&](const Vec3& P) {
+    v[a] += invM[a] * P;
+    w[a] += invI[a] * u.ra.cross(P);
+    if (b >= 0) {
+      v[size_t(b)] -= invM[size_t(b)] * P;
+      w[size_t(b)] -= invI[size_t(b)] * u.rb.cross(P);
+    } else if (bodyDyn) {
+      body->v -= body->invMass * P;
+      body->w -= body->invInertia * u.rb.cross(P);
+    }
+  };
+
+  // Normal.
+  {
+    const Real vn = u.n.dot(relVel());
+    const Real nl = std::max(u.lN + (u.rhsN - vn - u.eN * u.lN) * u.kN, u.loN);
+    const Real d = nl - u.lN;
+    u.lN = nl;
+    if (d != 0) applyP(d * u.n);
+    maxDelta = std::max(maxDelta, std::abs(d));
+  }
+  // Friction: scalar updates of both tangents at the same velocity, then projection onto the disc.
+  if (u.mu > 0) {
+    const Vec3 vr = relVel();
+    Real l1 = u.lT1 + (-u.t1.dot(vr) - u.eT * u.lT1) * u.kT1;
+    Real l2 = u.lT2 + (-u.t2.dot(vr) - u.eT * u.lT2) * u.kT2;
+    const Real lim = std::isinf(u.mu) ? 1e300 : u.mu * std::max<Real>(u.lN, 0);
+    const Real mag2 = l1 * l1 + l2 * l2;
+    if (mag2 > lim * lim) {
+      const Real s = lim / std::sqrt(mag2);
+      l1 *= s;
+      l2 *= s;
+    }
+    const Real d1 = l1 - u.lT1, d2 = l2 - u.lT2;
+    u.lT1 = l1;
+    u.lT2 = l2;
+    if (d1 != 0 || d2 != 0) applyP(d1 * u.t1 + d2 * u.t2);
+  }
+  // Rolling resistance: torque about the tangents opposing the relative rolling, disc bound.
+  if (u.rollMu > 0 && u.kR > 0) {
+    Vec3 wr = w[a];
+    if (b >= 0) wr -= w[size_t(b)];
+    else if (body) wr -= body->w;
+    Real l1 = u.lR1 + (-u.t1.dot(wr) - u.eT * u.lR1) * u.kR;
+    Real l2 = u.lR2 + (-u.t2.dot(wr) - u.eT * u.lR2) * u.kR;
+    const Real lim = u.rollMu * std::max<Real>(u.lN, 0);
+    const Real mag2 = l1 * l1 + l2 * l2;
+    if (mag2 > lim * lim) {
+      const Real s = lim / std::sqrt(mag2);
+      l1 *= s;
+      l2 *= s;
+    }
+    const Vec3 T = (l1 - u.lR1) * u.t1 + (l2 - u.lR2) * u.t2;
+    u.lR1 = l1;
+    u.lR2 = l2;
+    w[a] += invI[a] * T;
+    if (b >= 0) w[size_t(b)] -= invI[size_t(b)] * T;
+    else if (bodyDyn) body->w -= body->invInertia * T;
+  }
+}
+
+Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies, bool backward) {
+  auto& v = ps.velocities();
+  auto& w = ps.angularVelocities();
+  const auto& invM = ps.invMasses();
+  const int colors = int(numColors());
+  Real maxDelta = 0;
+  const bool par = units_.size() > kParallelMin;
+  auto runSerial = [&] {
+    if (!backward)
+      for (uint32_t k : serial_) solveUnit(units_[k], v, w, invM, invInertia_, bodies, maxDelta);
+    else
+      for (size_t j = serial_.size(); j-- > 0;) solveUnit(units_[serial_[j]], v, w, invM, invInertia_, bodies, maxDelta);
+  };
+  if (backward) runSerial();
+#pragma omp parallel if (par)
+  {
+    for (int ci = 0; ci < colors; ++ci) {
+      const int c = backward ? colors - 1 - ci : ci;
+      const long b0 = long(colorStart_[size_t(c)]), b1 = long(colorStart_[size_t(c) + 1]);
+      // Units of one colour share no particle, so their order (and the thread that runs them) does not matter.
+#pragma omp for schedule(static) reduction(max : maxDelta)
+      for (long k = b0; k < b1; ++k) solveUnit(units_[size_t(k)], v, w, invM, invInertia_, bodies, maxDelta);
+    }
+  }
+  if (!backward) runSerial();
+  return maxDelta;
+}
+
+void GranularStage::integrate(GranularBodySystem& ps, Real h, std::vector<size_t>& outNonFinite,
+                              std::vector<std::string>& outMessages, Real time) {
+  const size_t n = ps.size();
+  auto& x = ps.positions();
+  auto& v = ps.velocities();
+  auto& w = ps.angularVelocities();
+  const auto& invM = ps.invMasses();
+  bool bad = false;
+#pragma omp parallel for schedule(static) if (n > kParallelMin) reduction(|| : bad)
+  for (size_t i = 0; i < n; ++i) {
+    if (invM[i] <= 0) continue;
+    const Vec3 xn = x[i] + h * v[i];
+    if (xn.allFinite() && w[i].allFinite()) x[i] = xn;
+    else bad = true;
+  }
+  if (!bad) return;
+  for (size_t i = 0; i < n; ++i) {
+    if (invM[i] <= 0) continue;
+    if (v[i].allFinite() && w[i].allFinite() && (x[i] + h * v[i]).allFinite()) continue;
+    v[i].setZero();
+    w[i].setZero();
+    if (!ps.isAliveDense(i)) continue;
+    const size_t id = ps.idOfDense(i);
+    std::ostringstream msg;
+    msg << "Particle id " << id << " has a non-finite state after the step at t = " << time
+        << " s; kept its last position and stopped it";
+    outNonFinite.push_back(id);
+    outMessages.push_back(msg.str());
+  }
+}
+
+void GranularStage::storeResults(const GranularBodySystem& ps, Real h) {
+  auto& pp = collider_.getParticleParticleContacts();
+  auto& pg = collider_.getParticleGeometryContacts();
+  const Real invH = 1.0 / h;
+  nextPp_.clear();
+  nextPg_.clear();
+  for (const Unit& u : units_) {
+    if (!ps.isAliveDense(u.a) || (u.b >= 0 && !ps.isAliveDense(size_t(u.b)))) continue;
+    const Vec3 F = u.lT1 * u.t1 + u.lT2 * u.t2;
+    const Vec3 T = u.lR1 * u.t1 + u.lR2 * u.t2;
+    ParticleContact& c = u.b >= 0 ? pp[u.src] : pg[u.src];
+    c.normalForce = u.lN * invH;
+    c.frictionForce = F * invH;
+    const uint64_t sa = slotKey(ps.idOfDense(u.a));
+    if (u.b >= 0) {
+      const uint64_t sb = slotKey(ps.idOfDense(size_t(u.b)));
+      const Real s = u.flip ? -1.0 : 1.0;
+      nextPp_.push_back({u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0, u.lN, s * F, s * T});
+    } else {
+      nextPg_.push_back({sa << 32 | c.geometry->getId(), c.featureId, u.lN, F, T});
+    }
+  }
+  std::sort(nextPp_.begin(), nextPp_.end());
+  std::sort(nextPg_.begin(), nextPg_.end());
+  std::swap(ppCache_, nextPp_);
+  std::swap(pgCache_, nextPg_);
+}
+
+}  // namespace scree::detail

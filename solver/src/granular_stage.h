@@ -1,0 +1,105 @@
+// GranularStage: the particle path of Simulation::stepForward (internal to the solver module).
+//
+// Stages, called by Simulation in step order:
+//   collide    ParticleCollider (grid pairs, particle vs every geometry), every kReorderInterval steps the
+//              particles are first reordered along the grid for cache locality (ids stay stable)
+//   buildRows  one contact unit per particle contact point: a SPOOK normal row, two friction rows (projected
+//              cone, bound mu * normal impulse), and with rolling resistance two angular rows (disc bound
+//              coefficient * r_eff * normal impulse). Parameters come from the MaterialManager exactly as
+//              for rigid contacts (explicit contact material, else the combination rules). Adhesion: the
+//              normal impulse may pull down to -adhesiveForce * h and the rest overlap is the adhesive
+//              overlap. Speculative contacts (gap > 0): the row only forbids closing more than the gap in one
+//              step. Warm start from last step's impulses keyed by particle slots (stable across destroy of
+//              other particles and reorder) and geometry id + feature.
+//              Then the free velocities: v += h g.
+//   sweep      one projected Gauss-Seidel sweep. Units touching only particles (and static or kinematic
+//              geometry) are graph-coloured greedily in list order so that no two units of one colour share a
+//              particle; a colour is solved in parallel (OpenMP). Units touching a dynamic rigid body, and the
+//              colour overflow (> 63 colours), are solved serially after the colours. Within a colour no two
+//              units touch the same particle, so the result is bit-identical for any thread count.
+//              Sweeps alternate forward / backward over the colours (symmetric Gauss-Seidel, as the rigid PGS).
+//   integrate  x += h v for live particles; a particle whose velocity or position turns non-finite is
+//              reported by id, keeps its last position and is stopped.
+//   store      forces into the contact lists, impulses into the warm-start cache.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "scree/collide/particle_collider.h"
+#include "scree/core/granular_body_system.h"
+#include "scree/core/material.h"
+#include "scree/solver/pgs.h"
+#include "scree/solver/solver.h"
+
+namespace scree::detail {
+
+class GranularStage {
+ public:
+  static constexpr int kReorderInterval = 50;
+
+  /// True when there is anything for the particle path to do this step.
+  bool active(const GranularBodySystem& ps) const { return ps.size() > 0 || !units_.empty(); }
+
+  void collide(GranularBodySystem& ps, const std::vector<GeometryRef>& geometries, Real h);
+  /// solverIndexOf maps a body to its index in `bodies` (-1 when not in the simulation).
+  void buildRows(GranularBodySystem& ps, const MaterialManager& materials, const Solver& solver,
+                 std::vector<SolverBodyState>& bodies, const std::function<int(const RigidBody*)>& solverIndexOf,
+                 const Vec3& gravity, Real h);
+  /// Applies the warm-start impulses.
+  void prepare(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies);
+  /// One sweep; `backward` reverses the order. Returns the largest |delta lambda|.
+  Real sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies, bool backward);
+  /// True when some particle touches a dynamic rigid body (then Simulation interleaves the rigid sweeps).
+  bool coupled() const { return !serial_.empty(); }
+  bool hasUnits() const { return !units_.empty(); }
+  /// Positions; non-finite particles are appended to outNonFinite (ids) with a message each.
+  void integrate(GranularBodySystem& ps, Real h, std::vector<size_t>& outNonFinite, std::vector<std::string>& outMessages,
+                 Real time);
+  void storeResults(const GranularBodySystem& ps, Real h);
+
+  const std::vector<ParticleContact>& particleParticleContacts() const { return collider_.getParticleParticleContacts(); }
+  const std::vector<ParticleContact>& particleGeometryContacts() const { return collider_.getParticleGeometryContacts(); }
+  size_t numUnits() const { return units_.size(); }
+  size_t numColors() const { return colorStart_.empty() ? 0 : colorStart_.size() - 1; }
+
+ private:
+  // One contact point between particle a and particle b or a geometry (its rigid body index `body`, -1 none).
+  struct Unit {
+    uint32_t a = 0;
+    int32_t b = -1;       // particle, or -1
+    int32_t body = -1;    // rigid solver body for geometry contacts, or -1
+    uint32_t src = 0;     // index into the collider's pp (b >= 0) or pg list
+    Vec3 n = Vec3::Zero(), t1 = Vec3::Zero(), t2 = Vec3::Zero();
+    Vec3 ra = Vec3::Zero(), rb = Vec3::Zero();  // contact point relative to a's centre and b's centre / body's cm
+    Real kN = 0, kT1 = 0, kT2 = 0, kR = 0;     // 1 / (J M^-1 J^T + e) of normal, tangents, rolling
+    Real rhsN = 0, eN = 0, loN = 0, eT = 0, mu = 0, rollMu = 0;
+    Real lN = 0, lT1 = 0, lT2 = 0, lR1 = 0, lR2 = 0;
+    bool flip = false;    // a's slot is the higher one of the pair (warm-start vectors are stored for the lower)
+  };
+  struct CacheEntry {
+    uint64_t key;
+    uint32_t feature;
+    Real normal;
+    Vec3 friction, rolling;  // on the lower slot (pp) or on the particle (pg)
+    bool operator<(const CacheEntry& o) const { return key != o.key ? key < o.key : feature < o.feature; }
+  };
+  const CacheEntry* find(const std::vector<CacheEntry>& cache, uint64_t key, uint32_t feature) const;
+  void solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& w, const std::vector<Real>& invM,
+                 const std::vector<Real>& invI, std::vector<SolverBodyState>& bodies, Real& maxDelta) const;
+  void color(size_t numParticles);
+
+  ParticleCollider collider_;
+  uint64_t stepCount_ = 0;
+  std::vector<Unit> units_;          // all units, the parallel ones grouped by colour first
+  std::vector<uint32_t> colorStart_; // [numColors + 1] ranges into units_
+  std::vector<uint32_t> serial_;     // units solved serially (dynamic bodies, colour overflow), in list order
+  std::vector<Real> invInertia_;     // [size()] 1 / (0.4 m r^2)
+  std::vector<uint64_t> used_;       // colouring scratch, per particle
+  std::vector<Unit> scratchUnits_;
+  std::vector<uint8_t> colorOf_;
+  std::vector<CacheEntry> ppCache_, pgCache_, nextPp_, nextPg_;
+};
+
+}  // namespace scree::detail
