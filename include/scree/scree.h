@@ -24,6 +24,7 @@
 #include "scree/solver/simulation.h"
 #include "scree/solver/solver.h"
 #include "scree/solver/spook.h"
+#include "scree/model/granular_field_post_processor.h"
 #include "scree/model/model.h"
 #include "scree/model/two_body_tire_model.h"
 #include "scree/model/suction_gripper.h"
