@@ -10,6 +10,7 @@
 #include "scree/collide/narrowphase.h"
 #include "scree/core/errors.h"
 #include "scree/core/logger.h"
+#include "scree/solver/direct.h"
 #include "scree/solver/pgs.h"
 #include "scree/solver/spook.h"
 
@@ -90,6 +91,8 @@ struct Simulation::Impl {
   // Touching pairs of the last step (sorted) with their geometries, for impact/separation events.
   std::vector<std::pair<uint64_t, std::pair<Geometry*, Geometry*>>> prevPairs, curPairs;
   bool warnedSolveType = false;
+  DirectSolver direct;
+  std::vector<uint32_t> directSet, iterSet;
 
   const CacheEntry* find(uint64_t pair, uint32_t feature) const {
     CacheEntry key{pair, feature, 0, Vec3::Zero(), 0};
@@ -546,6 +549,7 @@ void Simulation::buildRows() {
           f.e = eVisc;
           f.mu = mu;
           f.solveType = r.solveType;
+          f.friction = true;
           f.lambda = ce ? ce->friction.dot(t) : 0.0;
           switch (ftype) {
             case FrictionModel::BOX: {
@@ -577,6 +581,7 @@ void Simulation::buildRows() {
           f.mu = rollMu;
           f.normalRow = nextNormal;
           f.solveType = r.solveType;
+          f.friction = true;
           if (k == 0) f.pairedRow = nextFriction + 1;
         }
         nextFriction += 2;
@@ -605,11 +610,11 @@ void Simulation::buildRows() {
     // Joints couple bodies for support levels too (a chain hanging from the world is supported link by link).
     m.contactRanges.push_back({ctx.indexA, ctx.indexB, begin, uint32_t(m.rows.size() - begin), true});
   }
-  if (nonIterative && !m.warnedSolveType) {
+  if (nonIterative && !m.warnedSolveType && !DirectSolver::available()) {
     m.warnedSolveType = true;
     Logger::warningOnce("scree.solveType.direct",
-                        "DIRECT / SPLIT / DIRECT_AND_ITERATIVE solve types are not available yet: those rows are "
-                        "solved by the iterative PGS solver");
+                        "DIRECT / SPLIT / DIRECT_AND_ITERATIVE solve types need SuiteSparse (built without "
+                        "SCREE_WITH_SUITESPARSE): those rows are solved by the iterative PGS solver");
   }
 
   SolverStats& st = solver_.stats();
@@ -624,18 +629,95 @@ void Simulation::buildRows() {
 
 void Simulation::solve() {
   Impl& m = *impl_;
+  SolverStats& st = solver_.stats();
+  st.numDirectRows = st.numIterativeRows = st.numFactorisations = st.numPivots = st.numSymbolicAnalyses = 0;
+  st.complementarityResidual = 0;
+  st.factorisationTime = 0;
+  st.directFallback = false;
   if (m.rows.empty()) {
-    solver_.stats().numIterations = 0;
-    solver_.stats().lastResidual = 0;
+    st.numIterations = 0;
+    st.lastResidual = 0;
     return;
   }
   PgsSolver::prepare(m.rows, m.sb);
-  solver_.stats().lastResidual = PgsSolver::iterate(m.rows, m.sb, solver_.getNumIterations());
-  solver_.stats().numIterations = size_t(solver_.getNumIterations());
-  if (solver_.getUseShockPropagation() && !m.contactRanges.empty()) {
-    buildShockOrder();
-    PgsSolver::shockPass(m.rows, m.sb, m.shock, solver_.getNumShockIterations());
+  // Direct set (DESIGN.md §2 step 7): DIRECT rows; SPLIT and DIRECT_AND_ITERATIVE rows except friction. PGS
+  // sweeps the rest, and DIRECT_AND_ITERATIVE rows too (after their direct solve).
+  m.directSet.clear();
+  m.iterSet.clear();
+  bool split = false;
+  if (DirectSolver::available())
+    for (uint32_t i = 0; i < m.rows.size(); ++i) {
+      const ConstraintRow& r = m.rows[i];
+      const auto t = r.solveType;
+      const bool direct = t == FrictionModel::DIRECT || (t != FrictionModel::ITERATIVE && !r.friction);
+      if (direct) m.directSet.push_back(i);
+      if (!direct || t == FrictionModel::DIRECT_AND_ITERATIVE) m.iterSet.push_back(i);
+      split |= t == FrictionModel::SPLIT && r.friction;
+    }
+  if (m.directSet.empty()) {
+    st.numIterativeRows = m.rows.size();
+    st.lastResidual = PgsSolver::iterate(m.rows, m.sb, solver_.getNumIterations());
+    st.numIterations = size_t(solver_.getNumIterations());
+    if (solver_.getUseShockPropagation() && !m.contactRanges.empty()) {
+      buildShockOrder();
+      PgsSolver::shockPass(m.rows, m.sb, m.shock, solver_.getNumShockIterations());
+    }
+    return;
   }
+  solveHybrid(split);
+}
+
+void Simulation::solveHybrid(bool finalDirect) {
+  // Hybrid (DESIGN.md §4): direct solve of the direct set with the iterative rows' impulses held, then PGS sweeps
+  // over the iterative set with the direct impulses held, numHybridRounds times; SPLIT friction ends with one
+  // more direct solve of the normals. Shock propagation visits only couplings whose rows are all iterative.
+  Impl& m = *impl_;
+  SolverStats& st = solver_.stats();
+  st.numDirectRows = m.directSet.size();
+  st.numIterativeRows = m.iterSet.size();
+  DirectSolver::Settings ds;
+  ds.form = solver_.getDirectForm();
+  ds.maxPivots = solver_.getMaxPivots();
+  auto direct = [&] {
+    const DirectSolver::Result r = m.direct.solve(m.rows, m.directSet, m.sb, ds);
+    st.numFactorisations += size_t(r.factorisations);
+    st.numPivots += size_t(r.pivots);
+    st.numSymbolicAnalyses += size_t(r.symbolicAnalyses);
+    st.factorisationTime += r.factorSeconds;
+    st.directForm = int(r.form);
+    st.complementarityResidual = r.residual;
+    if (!r.converged) {
+      st.directFallback = true;
+      Logger::warningOnce("scree.direct.fallback",
+                          "DIRECT solver: no solution within the pivot cap (Solver::setMaxPivots) or the matrix "
+                          "was not definite; the direct rows of such steps are finished by PGS "
+                          "(SolverStats::directFallback)");
+      st.complementarityResidual = PgsSolver::iterate(m.rows, m.sb, solver_.getNumIterations(), m.directSet);
+    }
+  };
+  const int rounds = m.iterSet.empty() ? 1 : solver_.getNumHybridRounds();
+  const int sweeps = std::max(1, (solver_.getNumIterations() + rounds - 1) / rounds);
+  st.numIterations = 0;
+  st.lastResidual = 0;
+  for (int round = 0; round < rounds; ++round) {
+    direct();
+    if (m.iterSet.empty()) break;
+    st.lastResidual = PgsSolver::iterate(m.rows, m.sb, sweeps, m.iterSet);
+    st.numIterations += size_t(sweeps);
+  }
+  if (!m.iterSet.empty() && solver_.getUseShockPropagation() && !m.contactRanges.empty()) {
+    buildShockOrder();
+    auto& sh = m.shock;
+    sh.erase(std::remove_if(sh.begin(), sh.end(),
+                            [&](const PgsSolver::ShockRange& r) {
+                              for (uint32_t i = r.begin; i < r.begin + r.count; ++i)
+                                if (m.rows[i].solveType != FrictionModel::ITERATIVE) return true;
+                              return false;
+                            }),
+             sh.end());
+    if (!sh.empty()) PgsSolver::shockPass(m.rows, m.sb, sh, solver_.getNumShockIterations());
+  }
+  if (finalDirect) direct();
 }
 
 void Simulation::buildShockOrder() {

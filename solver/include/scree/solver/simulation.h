@@ -96,6 +96,7 @@ class Simulation {
   void runPre();
   void buildRows();
   void solve();
+  void solveHybrid(bool finalDirect);
   void buildShockOrder();
   void integrate();
   void runPost();
