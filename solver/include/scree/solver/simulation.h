@@ -97,6 +97,7 @@ class Simulation {
   void buildRows();
   void solve();
   void solveHybrid(bool finalDirect);
+  void addGeometricStiffness();
   void buildShockOrder();
   void integrate();
   void runPost();

@@ -69,6 +69,10 @@ class Solver {
   /// Alternating direct / iterative rounds when both sets exist, >= 1. Default 2.
   void setNumHybridRounds(int n);
   int getNumHybridRounds() const { return hybridRounds_; }
+  /// Geometric-stiffness damping of direct-set joint rows (Simulation::addGeometricStiffness, default on): keeps
+  /// light links under heavy loads stable at large time steps at the price of damping their fast rotation.
+  void setUseGeometricStiffness(bool on) { geometricStiffness_ = on; }
+  bool getUseGeometricStiffness() const { return geometricStiffness_; }
   const SolverStats& getStats() const { return stats_; }
   SolverStats& stats() { return stats_; }
 
@@ -82,6 +86,7 @@ class Solver {
   DirectForm form_ = AUTO;
   int maxPivots_ = 50;
   int hybridRounds_ = 2;
+  bool geometricStiffness_ = true;
   SolverStats stats_;
 };
 
