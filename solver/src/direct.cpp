@@ -332,12 +332,8 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
     }
   };
 
-  int bestInfeasible = std::numeric_limits<int>::max(), noImprove = 0;
-  const int maxIter = anyBounded ? std::max(1, settings.maxPivots) : 1;
-  bool converged = false;
-  std::vector<std::pair<Real, int>> viol;
-  for (int iter = 0; iter < maxIter; ++iter) {
-    // Held rows sit on their current bounds.
+  // One numeric factorisation and solve with the current active set (held rows at their current bounds).
+  auto factorAndSolve = [&]() -> bool {
     for (int k = 0; k < n; ++k)
       if (m.state[k] != 0) m.lam[k] = m.state[k] < 0 ? m.lo[k] : m.hi[k];
     velocities(true);
@@ -364,6 +360,8 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
       for (int k = 0; k < n; ++k)
         Bx[rowBase + k] = m.state[k] != 0 ? -m.eReg[k] * m.lam[k] : -rows[set[k]].rhs;
     }
+    m.cm.supernodal = kkt ? CHOLMOD_SIMPLICIAL : CHOLMOD_AUTO;
+    m.cm.final_ll = kkt ? 0 : 1;
     const auto t0 = Clock::now();
     cholmod_factorize(A, fc.L, &m.cm);
     res.factorSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
@@ -372,82 +370,93 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
       // Not (quasi-)definite: drop the cached analysis and let the caller fall back.
       cholmod_free_factor(&fc.L, &m.cm);
       fc.p.clear();
-      break;
+      return false;
     }
     cholmod_solve2(CHOLMOD_A, fc.L, m.B, nullptr, &m.X, nullptr, &m.Y, &m.E, &m.cm);
     const Real* x = static_cast<const Real*>(m.X->x);
     for (int k = 0; k < n; ++k)
       if (m.state[k] == 0) m.lam[k] = x[rowBase + k];
-    if (!anyBounded) {
-      converged = true;
-      break;
-    }
-    // Check the active set.
-    updateBounds();
-    computeW();
-    Real scale = 1e-300;
-    for (int k = 0; k < n; ++k) scale = std::max(scale, std::abs(m.lam[k]));
-    const Real tol = 1e-9 * scale;
-    viol.clear();
-    for (int k = 0; k < n; ++k) {
-      Real v = 0;
-      if (m.state[k] == 0) {
-        v = std::max(m.lo[k] - m.lam[k], m.lam[k] - m.hi[k]);
-      } else if (m.state[k] < 0) {
-        v = -m.w[k] / m.ad[k];
+    return true;
+  };
+
+  // Outer passes: friction bounds frozen at mu * lambda_n of the last pass (a box LCP with fixed bounds inside,
+  // which block pivoting with Murty's fallback solves in finitely many steps since A is positive definite), until
+  // the bounds stop moving.
+  bool converged = false, failed = false;
+  const int maxIter = std::max(1, settings.maxPivots);
+  std::vector<std::pair<Real, int>> viol;
+  std::vector<Real> usedLo, usedHi;
+  constexpr int kMaxPasses = 10;
+  for (int pass = 0; pass < kMaxPasses && !failed && !converged; ++pass) {
+    int bestInfeasible = std::numeric_limits<int>::max(), noImprove = 0;
+    bool inner = false;
+    while (res.factorisations < maxIter) {
+      if (!factorAndSolve()) {
+        failed = true;
+        break;
+      }
+      if (!anyBounded) {
+        inner = true;
+        break;
+      }
+      computeW();
+      Real scale = 1e-300;
+      for (int k = 0; k < n; ++k) scale = std::max(scale, std::abs(m.lam[k]));
+      const Real tol = 1e-10 * scale;
+      viol.clear();
+      for (int k = 0; k < n; ++k) {
+        Real v = 0;
+        if (m.state[k] == 0) v = std::max(m.lo[k] - m.lam[k], m.lam[k] - m.hi[k]);
+        else if (m.state[k] < 0) v = m.lo[k] < m.hi[k] ? -m.w[k] / m.ad[k] : 0;
+        else v = m.lo[k] < m.hi[k] ? m.w[k] / m.ad[k] : 0;
+        if (v > tol) viol.push_back({v, k});
+      }
+      if (viol.empty()) {
+        inner = true;
+        break;
+      }
+      const int count = int(viol.size());
+      if (count < bestInfeasible) {
+        bestInfeasible = count;
+        noImprove = 0;
       } else {
-        v = m.w[k] / m.ad[k];
+        ++noImprove;
       }
-      if (v > tol) viol.push_back({v, k});
-    }
-    // Held friction rows whose bound moved with the normal need another solve (no pivot).
-    bool boundsMoved = false;
-    for (int k = 0; k < n && !boundsMoved; ++k)
-      if (m.state[k] != 0 && m.normalLocal[k] >= 0) {
-        const Real target = m.state[k] < 0 ? m.lo[k] : m.hi[k];
-        boundsMoved = std::abs(target - m.lam[k]) > tol;
+      if (noImprove >= 3) viol = {*std::max_element(viol.begin(), viol.end())};
+      for (const auto& [v, k] : viol) {
+        (void)v;
+        if (m.state[k] == 0) m.state[k] = m.lam[k] < m.lo[k] ? -1 : 1;
+        else m.state[k] = 0;
+        ++res.pivots;
       }
-    if (viol.empty() && !boundsMoved) {
-      converged = true;
-      break;
     }
-    if (viol.empty()) continue;
-    const int count = int(viol.size());
-    if (count < bestInfeasible) {
-      bestInfeasible = count;
-      noImprove = 0;
-    } else {
-      ++noImprove;
+    if (!inner) break;
+    // New friction bounds from this pass's normals.
+    usedLo = m.lo;
+    usedHi = m.hi;
+    updateBounds();
+    Real scale = 1e-300, moved = 0;
+    for (int k = 0; k < n; ++k) {
+      scale = std::max(scale, std::abs(m.lam[k]));
+      if (m.normalLocal[k] >= 0)
+        moved = std::max({moved, std::abs(m.lo[k] - usedLo[k]), std::abs(m.hi[k] - usedHi[k])});
     }
-    if (noImprove >= 3) {
-      auto worst = std::max_element(viol.begin(), viol.end());
-      viol = {*worst};
-    }
-    for (const auto& [v, k] : viol) {
-      (void)v;
-      if (m.state[k] == 0) m.state[k] = m.lam[k] < m.lo[k] ? -1 : 1;
-      else m.state[k] = 0;
-      ++res.pivots;
-    }
+    if (moved <= 1e-10 * scale) converged = true;
+    // Held rows sit on the new bounds; free rows now outside them are held at the nearer one.
+    for (int k = 0; k < n; ++k)
+      if (m.state[k] == 0 && (m.lam[k] < m.lo[k] || m.lam[k] > m.hi[k])) {
+        m.state[k] = m.lam[k] < m.lo[k] ? -1 : 1;
+        ++res.pivots;
+      }
   }
   res.converged = converged;
 
-  // Clamp (pivot cap or factorisation failure), project projected-cone pairs onto their discs.
+  // Clamp (pivot cap or factorisation failure). Projected-cone pairs stay a scaled box here: projecting them
+  // onto the disc afterwards would break the solution's complementarity.
   updateBounds();
   for (int k = 0; k < n; ++k) {
     if (!std::isfinite(m.lam[k])) m.lam[k] = m.lamOld[k], res.converged = false;
     m.lam[k] = std::clamp(m.lam[k], m.lo[k], m.hi[k]);
-  }
-  for (int k = 0; k + 1 < n; ++k) {
-    const ConstraintRow& r = rows[set[k]];
-    if (r.pairedRow != int32_t(set[k]) + 1 || int32_t(set[k + 1]) != r.pairedRow) continue;
-    const Real lim = m.hi[k];
-    const Real mag = std::hypot(m.lam[k], m.lam[k + 1]);
-    if (mag > lim) {
-      const Real sc = mag > 0 ? lim / mag : 0;
-      m.lam[k] *= sc;
-      m.lam[k + 1] *= sc;
-    }
   }
   computeW();
   Real resid = 0;

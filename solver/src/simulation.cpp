@@ -94,6 +94,7 @@ struct Simulation::Impl {
   DirectSolver direct;
   std::vector<uint32_t> directSet, iterSet;
   std::vector<Real> geomK;
+  bool pureIterative = false;  // some row is only in the iterative set
 
   const CacheEntry* find(uint64_t pair, uint32_t feature) const {
     CacheEntry key{pair, feature, 0, Vec3::Zero(), 0};
@@ -645,6 +646,7 @@ void Simulation::solve() {
   m.directSet.clear();
   m.iterSet.clear();
   bool split = false;
+  m.pureIterative = false;
   if (DirectSolver::available())
     for (uint32_t i = 0; i < m.rows.size(); ++i) {
       const ConstraintRow& r = m.rows[i];
@@ -652,6 +654,7 @@ void Simulation::solve() {
       const bool direct = t == FrictionModel::DIRECT || (t != FrictionModel::ITERATIVE && !r.friction);
       if (direct) m.directSet.push_back(i);
       if (!direct || t == FrictionModel::DIRECT_AND_ITERATIVE) m.iterSet.push_back(i);
+      m.pureIterative |= !direct;
       split |= t == FrictionModel::SPLIT && r.friction;
     }
   if (!m.directSet.empty()) addGeometricStiffness();
@@ -704,7 +707,7 @@ void Simulation::solveHybrid(bool finalDirect) {
   Impl& m = *impl_;
   SolverStats& st = solver_.stats();
   st.numDirectRows = m.directSet.size();
-  st.numIterativeRows = m.iterSet.size();
+  st.numIterativeRows = m.pureIterative ? m.iterSet.size() : 0;
   DirectSolver::Settings ds;
   ds.form = solver_.getDirectForm();
   ds.maxPivots = solver_.getMaxPivots();
@@ -725,6 +728,8 @@ void Simulation::solveHybrid(bool finalDirect) {
       st.complementarityResidual = PgsSolver::iterate(m.rows, m.sb, solver_.getNumIterations(), m.directSet);
     }
   };
+  // Without rows that only PGS solves, there is nothing to alternate with: one direct solve.
+  if (!m.pureIterative) m.iterSet.clear();
   const int rounds = m.iterSet.empty() ? 1 : solver_.getNumHybridRounds();
   const int sweeps = std::max(1, (solver_.getNumIterations() + rounds - 1) / rounds);
   st.numIterations = 0;

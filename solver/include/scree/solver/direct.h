@@ -18,9 +18,10 @@
 // numeric factorisation and solve, free rows outside their bounds are moved to the bound and held rows whose
 // w has the wrong sign are freed, all at once; if the number of infeasible rows has not dropped for three
 // iterations only the worst one changes per iteration (Murty's single principal pivot, finite for P-matrices).
-// Friction rows whose normal is in the set take the bounds +-mu * lambda_n of the current iterate (scaled box);
-// projected-cone pairs are solved as scaled boxes, then projected onto the disc. Past `maxPivots` iterations the
-// solve reports failure (the caller finishes the set with PGS and logs it).
+// Friction rows whose normal is in the set take the bounds +-mu * lambda_n (a box per direction: projected-cone
+// pairs are solved as scaled boxes here) in an outer loop: bounds frozen from the last pass's normals, the box LCP
+// solved by pivoting, until the bounds stop moving (at most 10 passes). Past `maxPivots` factorisations in all
+// the solve reports failure (the caller finishes the set with PGS and logs it).
 //
 // Equality systems (every row unbounded: joints, a particle lump with infinite friction and adhesion and zero
 // adhesive overlap -- the manual's DIRECT particle mode) need one factorisation and no pivot.
