@@ -108,6 +108,8 @@ void Joint::pushLinear(const ConstraintContext& ctx, std::vector<ConstraintRow>&
   r.jAngA = f.rA.cross(u);
   r.jLinB = -u;
   r.jAngB = -f.rB.cross(u);
+  r.leverA = f.rA.norm();
+  r.leverB = f.rB.norm();
   finishRow(ctx, r, dof, g, compliance, damping);
   rows.push_back(r);
   dofs.push_back(dof);

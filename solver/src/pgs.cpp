@@ -124,6 +124,28 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   return maxDelta;
 }
 
+Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
+                        const std::vector<uint32_t>& subset) {
+  Real maxDelta = 0;
+  const size_t n = subset.size();
+  for (int it = 0; it < iterations; ++it) {
+    maxDelta = 0;
+    if (it % 2 == 0) {
+      for (size_t k = 0; k < n; ++k) {
+        const uint32_t i = subset[k];
+        maxDelta = std::max(maxDelta, solveUnit(rows, bodies, i));
+        if (rows[i].pairedRow == int32_t(i) + 1) ++k;
+      }
+    } else {
+      for (size_t k = n; k-- > 0;) {
+        if (k > 0 && rows[subset[k - 1]].pairedRow == int32_t(subset[k])) --k;
+        maxDelta = std::max(maxDelta, solveUnit(rows, bodies, subset[k]));
+      }
+    }
+  }
+  return maxDelta;
+}
+
 void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                           const std::vector<ShockRange>& ranges, int maxSweeps) {
   auto solveFrozen = [&](ConstraintRow& r, int frozen, Real lo, Real hi) -> Real {

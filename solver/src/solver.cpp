@@ -14,6 +14,16 @@ void Solver::setNumShockIterations(int n) {
   shockIterations_ = n;
 }
 
+void Solver::setMaxPivots(int n) {
+  if (n < 1) detail::throwInvalid("Solver::setMaxPivots", "maxPivots", (long long)n, "must be >= 1");
+  maxPivots_ = n;
+}
+
+void Solver::setNumHybridRounds(int n) {
+  if (n < 1) detail::throwInvalid("Solver::setNumHybridRounds", "numHybridRounds", (long long)n, "must be >= 1");
+  hybridRounds_ = n;
+}
+
 void Solver::setRestitutionThreshold(Real v) {
   detail::requireNonNegative("Solver::setRestitutionThreshold", "threshold", v);
   restitutionThreshold_ = v;

@@ -78,7 +78,10 @@ class Constraint {
   std::vector<Real> compliance_, damping_;
   std::vector<Real> lastForce_;
   std::vector<Real> warm_;  ///< last impulse per DOF
-  FrictionModel::SolveType solveType_ = FrictionModel::ITERATIVE;
+  /// Default DIRECT_AND_ITERATIVE (AGX's default for constraints): the rows are solved by the direct solver and
+  /// then swept by PGS with the iterative rows (contacts) of the step, which couples them; with no iterative
+  /// rows it is a pure direct solve. See docs/speed-accuracy.md for the measurements.
+  FrictionModel::SolveType solveType_ = FrictionModel::DIRECT_AND_ITERATIVE;
   const char* typeName_;
 };
 using ConstraintRef = std::shared_ptr<Constraint>;

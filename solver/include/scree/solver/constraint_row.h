@@ -26,6 +26,11 @@ struct ConstraintRow {
   /// Projected-cone friction: index of the partner tangent row (solved as a 2x2 block), or -1.
   int32_t pairedRow = -1;
   FrictionModel::SolveType solveType = FrictionModel::ITERATIVE;
+  /// Tangential (friction or rolling) row of a contact: SPLIT and DIRECT_AND_ITERATIVE send it to PGS.
+  bool friction = false;
+  /// Lever arms |r| from each body's centre of mass to the point the row acts at (joints' linear rows), m; used
+  /// for the geometric-stiffness term of the direct solve (Simulation::solve). 0: none.
+  Real leverA = 0, leverB = 0;
 
   // Filled by the solver's prepare step.
   Vec3 mJLinA = Vec3::Zero(), mJAngA = Vec3::Zero(), mJLinB = Vec3::Zero(), mJAngB = Vec3::Zero();  ///< M^-1 J^T

@@ -31,6 +31,10 @@ class PgsSolver {
   static void prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies);
   /// `iterations` sweeps over all rows in order. Returns the largest |delta lambda| of the last sweep.
   static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations);
+  /// The same sweeps over the rows listed in `subset` only (ascending indices; a projected-cone pair must be
+  /// listed whole); the other rows' impulses are held fixed. Used by the hybrid direct/iterative solve.
+  static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
+                      const std::vector<uint32_t>& subset);
 
   /// A row range whose body `frozen` (0 = A, 1 = B) is held immovable in the shock-propagation pass.
   struct ShockRange {

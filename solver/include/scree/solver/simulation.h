@@ -108,6 +108,8 @@ class Simulation {
   void runPre();
   void buildRows();
   void solve();
+  void solveHybrid(bool finalDirect);
+  void addGeometricStiffness();
   void buildShockOrder();
   void integrate();
   void runPost();

@@ -15,10 +15,28 @@ struct SolverStats {
   size_t numIterations = 0;
   size_t numWarmStarted = 0; ///< contact points matched to last step's impulses
   Real lastResidual = 0;     ///< max |delta lambda| of the last PGS sweep, N s
+  // DIRECT solver (direct.h), zero when no row is in the direct set.
+  size_t numDirectRows = 0;     ///< rows solved by the direct solver
+  size_t numIterativeRows = 0;  ///< rows swept by PGS
+  size_t numFactorisations = 0; ///< numeric factorisations this step (one per block-pivoting iteration)
+  size_t numPivots = 0;         ///< active-set changes (block pivoting) this step
+  size_t numSymbolicAnalyses = 0;  ///< symbolic analyses this step (0 while the sparsity pattern is unchanged)
+  int directForm = 0;           ///< Solver::DirectForm used by the last direct solve (SCHUR or KKT)
+  bool directFallback = false;  ///< the pivot cap was hit and the direct set was finished by PGS (logged)
+  /// Complementarity residual of the direct set after the step: max over rows of
+  /// |lambda - clamp(lambda - w / A_ii, lo, hi)| with w = J v+ + e lambda - rhs, N s (0: the mixed LCP holds).
+  Real complementarityResidual = 0;
+  double factorisationTime = 0; ///< s, wall time in numeric factorisations this step
 };
 
 class Solver {
  public:
+  /// Matrix form of the DIRECT solve (DESIGN.md §4). SCHUR: A = G M^-1 G^T + E, CHOLMOD LL^T. KKT: the
+  /// quasi-definite [M -G^T; -G -E], CHOLMOD LDL^T without pivoting. AUTO: KKT when the Schur matrix would have
+  /// more nonzeros than KKT_RATIO times the KKT matrix (bodies carrying many rows), else SCHUR (see
+  /// docs/speed-accuracy.md for the measurements behind it).
+  enum DirectForm { AUTO = 0, SCHUR = 1, KKT = 2 };
+
   /// PGS sweeps per step, >= 1. Default 16.
   void setNumIterations(int n);
   int getNumIterations() const { return iterations_; }
@@ -42,6 +60,19 @@ class Solver {
   /// Largest number of sweeps per support level in the shock pass, >= 1. Default 16.
   void setNumShockIterations(int n);
   int getNumShockIterations() const { return shockIterations_; }
+  void setDirectForm(DirectForm f) { form_ = f; }
+  DirectForm getDirectForm() const { return form_; }
+  /// Cap on block-pivoting iterations per direct solve, >= 1. Default 50. Past it the direct set is finished
+  /// by PGS and a warning is logged.
+  void setMaxPivots(int n);
+  int getMaxPivots() const { return maxPivots_; }
+  /// Alternating direct / iterative rounds when both sets exist, >= 1. Default 2.
+  void setNumHybridRounds(int n);
+  int getNumHybridRounds() const { return hybridRounds_; }
+  /// Geometric-stiffness damping of direct-set joint rows (Simulation::addGeometricStiffness, default on): keeps
+  /// light links under heavy loads stable at large time steps at the price of damping their fast rotation.
+  void setUseGeometricStiffness(bool on) { geometricStiffness_ = on; }
+  bool getUseGeometricStiffness() const { return geometricStiffness_; }
   const SolverStats& getStats() const { return stats_; }
   SolverStats& stats() { return stats_; }
 
@@ -52,6 +83,10 @@ class Solver {
   Real maxRecovery_ = 0;
   bool shock_ = true;
   int shockIterations_ = 16;
+  DirectForm form_ = AUTO;
+  int maxPivots_ = 50;
+  int hybridRounds_ = 2;
+  bool geometricStiffness_ = true;
   SolverStats stats_;
 };
 
