@@ -28,7 +28,9 @@ struct VehicleParams {
   bool bump = false;
   Real bumpX = 3.0, bumpHeight = 0.08, bumpRadius = 0.3;  ///< bump across the path at x, m
   Real mu = 0.8;
-  Real dt = 1.0 / 400;                     ///< PGS needs small steps for the stiff wheel chains
+  /// 1/400 s keeps the PGS wheel chains tight (parked sag error ~1e-7); at 1/60 the vehicle still runs stably,
+  /// with parked sag -0.2 % and 1.85 instead of 2 m/s 5 s into the bump drive.
+  Real dt = 1.0 / 400;
   int iterations = 20;
 };
 
