@@ -2,8 +2,9 @@
 // a 10-box tower, a 6-row pyramid, a box sliding to rest on friction, a bouncing ball (restitution), a heavy
 // box on a light one (1000:1), and a mixed pile of spheres, capsules, cylinders and convex hulls dropped on the
 // ground, plus jointed mechanisms: a motor-driven arm (hinge with a speed motor and a force limit) and a six-link
-// pendulum chain on ball joints, and a suction gripper pick-and-place (demo_suction.h). Prints a one-line summary
-// per simulated second. Then a four-wheeled vehicle on TwoBodyTireModel tires drives over a bump (demo_vehicle.h).
+// pendulum chain on ball joints, a suction gripper pick-and-place (demo_suction.h) and a granular pile poured
+// from a nozzle (demo_granular.h). Prints a one-line summary per simulated second. Then a four-wheeled vehicle on
+// TwoBodyTireModel tires drives over a bump (demo_vehicle.h).
 //
 // Usage: scree_demo [seconds=5] [iterations=16]
 #include <cmath>
@@ -16,6 +17,7 @@
 
 #include "demo_vehicle.h"
 #include "demo_suction.h"
+#include "demo_granular.h"
 
 using namespace scree;
 
@@ -115,6 +117,9 @@ int main(int argc, char** argv) {
 
   // Suction gripper: picks a 4 kg box at (0, 17, 0), carries it 1.5 m along x and releases it (pump off).
   auto suction = SuctionPickPlace::build(sim, stone, Vec3(0, 17, 0));
+  // Granular pile at (-5, -5): particles poured at run time.
+  auto granularPile = std::make_shared<demo::GranularPile>(sim, stone);
+  sim.add(granularPile);
 
   const Real towerTop0 = tower.back()->getPosition().z();
   const Real pyramidTop0 = pyramidTop->getPosition().z();
@@ -150,6 +155,7 @@ int main(int argc, char** argv) {
   std::printf("slider stopped after %.4f m (Coulomb: v^2/(2 mu g) = %.4f m)\n", slider->getPosition().x() - sliderX0,
               expectedSlide);
   suction->printSummary();
+  granularPile->printSummary();
   std::printf("%d steps, %.3f ms/step (solve %.3f ms)\n", steps, 1000 * totalTime / steps, 1000 * solveTime / steps);
   const auto& report = sim.getLastStepReport();
   const bool vehicleOk = runVehicleDemo(std::min(seconds, 4.0));

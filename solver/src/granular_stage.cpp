@@ -14,8 +14,7 @@ namespace {
 // Parallel loops below this many items run serially (the fork/join would cost more than the work); results
 // are the same either way.
 constexpr size_t kParallelMin = 2048;
-constexpr uint8_t kSerial = 255;
-constexpr int kMaxColors = 64;
+constexpr int kMaxSlabs = 64;
 
 uint64_t slotKey(size_t id) { return uint64_t(uint32_t(id & 0xffffffffu)); }
 
@@ -246,7 +245,7 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
     }
   }
 
-  color(n);
+  partition(ps);
 
   // Free velocities.
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
@@ -254,51 +253,48 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
     if (invM[i] > 0) v[i] += h * gravity;
 }
 
-void GranularStage::color(size_t numParticles) {
-  // Greedy colouring in list order: a unit takes the lowest colour free at both of its particles. Units that
-  // touch a dynamic rigid body (shared by many units) go to the serial list, as do units beyond 63 colours.
+void GranularStage::partition(const GranularBodySystem& ps) {
+  // Slabs along the axis of largest extent of the particle cloud, each at least one grid cell wide (the
+  // largest particle-pair reach), so a contact's two particles lie in the same or adjacent slabs. A unit
+  // belongs to the lower slab of its particles: units of two even (or two odd) slabs never share a particle.
+  // The partition depends on the particle positions only, never on the number of threads.
   const size_t nu = scratchUnits_.size();
-  used_.assign(numParticles, 0);
-  colorOf_.resize(nu);
-  std::vector<uint32_t> count(kMaxColors + 1, 0);
+  const auto& x = ps.positions();
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (size_t i = 0; i < ps.size(); ++i) {
+    if (!ps.isAliveDense(i)) continue;
+    lo = lo.cwiseMin(x[i]);
+    hi = hi.cwiseMax(x[i]);
+  }
+  int axis = 0;
+  const Vec3 ext = (hi - lo).cwiseMax(Vec3::Zero());
+  if (ext.y() > ext[axis]) axis = 1;
+  if (ext.z() > ext[axis]) axis = 2;
+  const Real cell = collider_.getCellSize();
+  int numSlabs = cell > 0 ? int(std::min<Real>(kMaxSlabs, std::floor(ext[axis] / cell))) : 1;
+  if (numSlabs < 4 || nu < kParallelMin) numSlabs = 1;  // too narrow or too small to be worth splitting
+  const Real width = numSlabs > 1 ? ext[axis] / Real(numSlabs) : 1.0;
+  auto slabOfParticle = [&](size_t i) {
+    if (numSlabs == 1) return 0;
+    return std::clamp(int(std::floor((x[i][axis] - lo[axis]) / width)), 0, numSlabs - 1);
+  };
+  slabOf_.resize(nu);
+  std::vector<uint32_t> count(size_t(numSlabs) + 1, 0);
   for (size_t k = 0; k < nu; ++k) {
     const Unit& u = scratchUnits_[k];
-    if (u.body >= 0) {
-      colorOf_[k] = kSerial;
-      ++count[kMaxColors];
-      continue;
-    }
-    uint64_t mask = used_[u.a];
-    if (u.b >= 0) mask |= used_[size_t(u.b)];
-    if (mask == ~uint64_t(0)) {
-      colorOf_[k] = kSerial;
-      ++count[kMaxColors];
-      continue;
-    }
-    const int c = std::countr_one(mask);
-    colorOf_[k] = uint8_t(c);
-    ++count[size_t(c)];
-    used_[u.a] |= uint64_t(1) << c;
-    if (u.b >= 0) used_[size_t(u.b)] |= uint64_t(1) << c;
+    int sl;
+    if (u.body >= 0) sl = numSlabs;  // touches a dynamic rigid body: serial
+    else if (u.b >= 0) sl = std::min(slabOfParticle(u.a), slabOfParticle(size_t(u.b)));
+    else sl = slabOfParticle(u.a);
+    slabOf_[k] = uint16_t(sl);
+    ++count[size_t(sl)];
   }
-  int numColors = 0;
-  for (int c = 0; c < kMaxColors; ++c)
-    if (count[size_t(c)] > 0) numColors = c + 1;
-  colorStart_.assign(size_t(numColors) + 1, 0);
-  for (int c = 0; c < numColors; ++c) colorStart_[size_t(c) + 1] = colorStart_[size_t(c)] + count[size_t(c)];
-  std::vector<uint32_t> cursor(colorStart_.begin(), colorStart_.end() - 1);
-  const uint32_t serialBegin = colorStart_.back();
-  uint32_t serialCursor = serialBegin;
+  slabStart_.assign(size_t(numSlabs) + 2, 0);
+  for (int sl = 0; sl <= numSlabs; ++sl) slabStart_[size_t(sl) + 1] = slabStart_[size_t(sl)] + count[size_t(sl)];
+  std::vector<uint32_t> cursor(slabStart_.begin(), slabStart_.end() - 1);
   units_.resize(nu);
-  serial_.clear();
-  for (size_t k = 0; k < nu; ++k) {
-    if (colorOf_[k] == kSerial) {
-      serial_.push_back(serialCursor);
-      units_[serialCursor++] = scratchUnits_[k];
-    } else {
-      units_[cursor[colorOf_[k]]++] = scratchUnits_[k];
-    }
-  }
+  for (size_t k = 0; k < nu; ++k) units_[cursor[slabOf_[k]]++] = scratchUnits_[k];
+  numSlabs_ = numSlabs;
 }
 
 void GranularStage::prepare(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies) {
@@ -401,27 +397,34 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
   auto& v = ps.velocities();
   auto& w = ps.angularVelocities();
   const auto& invM = ps.invMasses();
-  const int colors = int(numColors());
   Real maxDelta = 0;
-  const bool par = units_.size() > kParallelMin;
-  auto runSerial = [&] {
+  auto runRange = [&](uint32_t b0, uint32_t b1) {
+    Real md = 0;
     if (!backward)
-      for (uint32_t k : serial_) solveUnit(units_[k], v, w, invM, invInertia_, bodies, maxDelta);
+      for (uint32_t k = b0; k < b1; ++k) solveUnit(units_[k], v, w, invM, invInertia_, bodies, md);
     else
-      for (size_t j = serial_.size(); j-- > 0;) solveUnit(units_[serial_[j]], v, w, invM, invInertia_, bodies, maxDelta);
+      for (uint32_t k = b1; k-- > b0;) solveUnit(units_[k], v, w, invM, invInertia_, bodies, md);
+    return md;
   };
-  if (backward) runSerial();
-#pragma omp parallel if (par)
-  {
-    for (int ci = 0; ci < colors; ++ci) {
-      const int c = backward ? colors - 1 - ci : ci;
-      const long b0 = long(colorStart_[size_t(c)]), b1 = long(colorStart_[size_t(c) + 1]);
-      // Units of one colour share no particle, so their order (and the thread that runs them) does not matter.
-#pragma omp for schedule(static) reduction(max : maxDelta)
-      for (long k = b0; k < b1; ++k) solveUnit(units_[size_t(k)], v, w, invM, invInertia_, bodies, maxDelta);
+  const int S = numSlabs_;
+  const uint32_t serialBegin = slabStart_[size_t(S)], serialEnd = slabStart_[size_t(S) + 1];
+  if (backward) maxDelta = std::max(maxDelta, runRange(serialBegin, serialEnd));
+  if (S == 1) {
+    maxDelta = std::max(maxDelta, runRange(slabStart_[0], slabStart_[1]));
+  } else {
+    // Two phases (even slabs, then odd; reversed when sweeping backward), each slab a serial Gauss-Seidel run:
+    // slabs of one phase share no particle, so which thread runs which slab does not change any bit.
+#pragma omp parallel
+    for (int ph = 0; ph < 2; ++ph) {
+      const int parity = backward ? 1 - ph : ph;
+#pragma omp for schedule(dynamic, 1) reduction(max : maxDelta)
+      for (int j = 0; j < (S - parity + 1) / 2; ++j) {
+        const int sl = backward ? S - 1 - ((S - 1 - parity) % 2) - 2 * j : parity + 2 * j;
+        maxDelta = std::max(maxDelta, runRange(slabStart_[size_t(sl)], slabStart_[size_t(sl) + 1]));
+      }
     }
   }
-  if (!backward) runSerial();
+  if (!backward) maxDelta = std::max(maxDelta, runRange(serialBegin, serialEnd));
   return maxDelta;
 }
 
