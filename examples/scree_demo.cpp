@@ -2,7 +2,8 @@
 // a 10-box tower, a 6-row pyramid, a box sliding to rest on friction, a bouncing ball (restitution), a heavy
 // box on a light one (1000:1), and a mixed pile of spheres, capsules, cylinders and convex hulls dropped on the
 // ground, plus jointed mechanisms: a motor-driven arm (hinge with a speed motor and a force limit) and a six-link
-// pendulum chain on ball joints. Prints a one-line summary per simulated second.
+// pendulum chain on ball joints, and a granular pile poured from a nozzle (demo_granular.h). Prints a one-line
+// summary per simulated second.
 //
 // Usage: scree_demo [seconds=5] [iterations=16]
 #include <cmath>
@@ -12,6 +13,8 @@
 #include <vector>
 
 #include <scree/scree.h>
+
+#include "demo_granular.h"
 
 using namespace scree;
 
@@ -109,6 +112,10 @@ int main(int argc, char** argv) {
     prevLink = link;
   }
 
+  // Granular pile at (-5, -5): particles poured at run time.
+  auto granularPile = std::make_shared<demo::GranularPile>(sim, stone);
+  sim.add(granularPile);
+
   const Real towerTop0 = tower.back()->getPosition().z();
   const Real pyramidTop0 = pyramidTop->getPosition().z();
   const Real sliderX0 = slider->getPosition().x();
@@ -142,6 +149,7 @@ int main(int argc, char** argv) {
   const Real expectedSlide = 25.0 / (2 * 0.5 * 9.81);
   std::printf("slider stopped after %.4f m (Coulomb: v^2/(2 mu g) = %.4f m)\n", slider->getPosition().x() - sliderX0,
               expectedSlide);
+  granularPile->printSummary();
   std::printf("%d steps, %.3f ms/step (solve %.3f ms)\n", steps, 1000 * totalTime / steps, 1000 * solveTime / steps);
   const auto& report = sim.getLastStepReport();
   return report.ok() ? 0 : 1;

@@ -242,6 +242,8 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
   }
 }
 
+Real ParticleCollider::getCellSize() const { return impl_->cell; }
+
 std::vector<uint32_t> ParticleCollider::localityOrder(const GranularBodySystem& ps) const {
   const Impl& m = *impl_;
   const size_t n = ps.size();

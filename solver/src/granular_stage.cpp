@@ -14,8 +14,7 @@ namespace {
 // Parallel loops below this many items run serially (the fork/join would cost more than the work); results
 // are the same either way.
 constexpr size_t kParallelMin = 2048;
-constexpr uint8_t kSerial = 255;
-constexpr int kMaxColors = 64;
+constexpr int kMaxSlabs = 64;
 
 uint64_t slotKey(size_t id) { return uint64_t(uint32_t(id & 0xffffffffu)); }
 
@@ -53,7 +52,7 @@ PairParams makeParams(const SurfaceParameters& s, Real h) {
 
 const GranularStage::CacheEntry* GranularStage::find(const std::vector<CacheEntry>& cache, uint64_t key,
                                                      uint32_t feature) const {
-  CacheEntry probe{key, feature, 0, Vec3::Zero(), Vec3::Zero()};
+  CacheEntry probe{key, feature, 0, Vec3::Zero(), Vec3::Zero(), 0};
   auto it = std::lower_bound(cache.begin(), cache.end(), probe);
   if (it != cache.end() && it->key == key && it->feature == feature) return &*it;
   return nullptr;
@@ -132,17 +131,20 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
   scratchUnits_.resize(numUnits);
   const Real threshold = solver.getRestitutionThreshold();
   const Real maxRecovery = solver.getMaxPenetrationRecoverySpeed();
-  const bool warm = solver.getUseWarmStarting();
-  const Real gravityNorm = gravity.norm();
-  (void)gravityNorm;
+  const bool warm = solver.getUseWarmStarting();  // the impact memory is kept either way
 
-  // Normal row from the pair parameters; vn0 is the normal relative velocity at the start of the step.
-  auto normalRow = [&](Unit& u, const PairParams& p, Real depth, Real vn0, Real nAdh) {
-    const Real adhF = p.adhF / nAdh;
+  // Normal row from the pair parameters; vn0 is the normal relative velocity at the start of the step, vnFree
+  // after this step's gravity, remembered the approach speed of last step's speculative stop (0 if none).
+  // Speculative contacts stop an approach exactly at the surface; the approach speed is then remembered so
+  // that the next step (touching) bounces with restitution * that speed, as the rigid contacts do.
+  auto normalRow = [&](Unit& u, const PairParams& p, Real depth, Real vn0, Real vnFree, Real remembered) {
+    const Real adhF = p.adhF;
     if (depth < 0 && adhF <= 0) {
       u.rhsN = depth / h;  // speculative: may close the gap, no force before that
       u.eN = 0;
       u.loN = 0;
+      if (remembered > threshold) u.rhsN = std::max(u.rhsN, p.rest * remembered);
+      else if (vnFree * h < depth && -vnFree > threshold) u.impact = -vnFree;
       return;
     }
     const Real g = (adhF > 0 ? p.adhO : 0.0) - depth;
@@ -151,7 +153,8 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
     u.rhsN = bias + p.upsilon * vn0;
     u.eN = p.eN;
     u.loN = adhF > 0 ? (std::isinf(adhF) ? -1e300 : -adhF * h) : 0.0;
-    if (-vn0 > threshold) u.rhsN = std::max(u.rhsN, p.rest * -vn0);
+    const Real approach = std::max(remembered, -vn0);
+    if (approach > threshold) u.rhsN = std::max(u.rhsN, p.rest * approach);
   };
   auto effMass = [](Real im, Real ii, const Vec3& r, const Vec3& d) { return im + ii * r.cross(d).squaredNorm(); };
   auto bodyEff = [](const SolverBodyState& b, const Vec3& r, const Vec3& d) {
@@ -209,7 +212,23 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
       const Real gr = rollingRadiusOf(c.geometry);
       if (gr > 0) rollR = r[a] * gr / (r[a] + gr);
     }
-    normalRow(u, p, c.depth, u.n.dot(vrel), 1.0);
+    // Warm start and remembered impact speed.
+    const CacheEntry* ce = nullptr;
+    Real sgn = 1.0;
+    {
+      const size_t idA = ps.idOfDense(a);
+      if (isPP) {
+        const uint64_t sa = slotKey(idA), sb = slotKey(ps.idOfDense(size_t(c.b)));
+        u.flip = sa > sb;
+        sgn = u.flip ? -1.0 : 1.0;
+        ce = find(ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
+      } else {
+        ce = find(pgCache_, slotKey(idA) << 32 | c.geometry->getId(), c.featureId);
+      }
+    }
+    const Real vn0 = u.n.dot(vrel);
+    const Real vnFree = vn0 + (isPP ? 0.0 : h * gravity.dot(u.n));
+    normalRow(u, p, c.depth, vn0, vnFree, ce ? ce->impact : 0.0);
     u.kN = 1.0 / (kn + u.eN);
     u.mu = p.mu;
     u.eT = p.eT;
@@ -217,36 +236,16 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
     u.kT2 = 1.0 / (kt2 + u.eT);
     u.rollMu = p.rolling * rollR;
     u.kR = kr > 0 ? 1.0 / (kr + u.eT) : 0.0;
-
-    // Warm start.
-    if (warm) {
-      const size_t idA = ps.idOfDense(a);
-      if (isPP) {
-        const uint64_t sa = slotKey(idA), sb = slotKey(ps.idOfDense(size_t(c.b)));
-        u.flip = sa > sb;
-        const CacheEntry* ce = find(ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
-        if (ce) {
-          const Real s = u.flip ? -1.0 : 1.0;
-          u.lN = std::max(ce->normal, u.loN);
-          u.lT1 = s * ce->friction.dot(u.t1);
-          u.lT2 = s * ce->friction.dot(u.t2);
-          u.lR1 = s * ce->rolling.dot(u.t1);
-          u.lR2 = s * ce->rolling.dot(u.t2);
-        }
-      } else {
-        const CacheEntry* ce = find(pgCache_, slotKey(idA) << 32 | c.geometry->getId(), c.featureId);
-        if (ce) {
-          u.lN = std::max(ce->normal, u.loN);
-          u.lT1 = ce->friction.dot(u.t1);
-          u.lT2 = ce->friction.dot(u.t2);
-          u.lR1 = ce->rolling.dot(u.t1);
-          u.lR2 = ce->rolling.dot(u.t2);
-        }
-      }
+    if (ce && warm) {
+      u.lN = std::max(ce->normal, u.loN);
+      u.lT1 = sgn * ce->friction.dot(u.t1);
+      u.lT2 = sgn * ce->friction.dot(u.t2);
+      u.lR1 = sgn * ce->rolling.dot(u.t1);
+      u.lR2 = sgn * ce->rolling.dot(u.t2);
     }
   }
 
-  color(n);
+  partition(ps);
 
   // Free velocities.
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
@@ -254,51 +253,48 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
     if (invM[i] > 0) v[i] += h * gravity;
 }
 
-void GranularStage::color(size_t numParticles) {
-  // Greedy colouring in list order: a unit takes the lowest colour free at both of its particles. Units that
-  // touch a dynamic rigid body (shared by many units) go to the serial list, as do units beyond 63 colours.
+void GranularStage::partition(const GranularBodySystem& ps) {
+  // Slabs along the axis of largest extent of the particle cloud, each at least one grid cell wide (the
+  // largest particle-pair reach), so a contact's two particles lie in the same or adjacent slabs. A unit
+  // belongs to the lower slab of its particles: units of two even (or two odd) slabs never share a particle.
+  // The partition depends on the particle positions only, never on the number of threads.
   const size_t nu = scratchUnits_.size();
-  used_.assign(numParticles, 0);
-  colorOf_.resize(nu);
-  std::vector<uint32_t> count(kMaxColors + 1, 0);
+  const auto& x = ps.positions();
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (size_t i = 0; i < ps.size(); ++i) {
+    if (!ps.isAliveDense(i)) continue;
+    lo = lo.cwiseMin(x[i]);
+    hi = hi.cwiseMax(x[i]);
+  }
+  int axis = 0;
+  const Vec3 ext = (hi - lo).cwiseMax(Vec3::Zero());
+  if (ext.y() > ext[axis]) axis = 1;
+  if (ext.z() > ext[axis]) axis = 2;
+  const Real cell = collider_.getCellSize();
+  int numSlabs = cell > 0 ? int(std::min<Real>(kMaxSlabs, std::floor(ext[axis] / cell))) : 1;
+  if (numSlabs < 4 || nu < kParallelMin) numSlabs = 1;  // too narrow or too small to be worth splitting
+  const Real width = numSlabs > 1 ? ext[axis] / Real(numSlabs) : 1.0;
+  auto slabOfParticle = [&](size_t i) {
+    if (numSlabs == 1) return 0;
+    return std::clamp(int(std::floor((x[i][axis] - lo[axis]) / width)), 0, numSlabs - 1);
+  };
+  slabOf_.resize(nu);
+  std::vector<uint32_t> count(size_t(numSlabs) + 1, 0);
   for (size_t k = 0; k < nu; ++k) {
     const Unit& u = scratchUnits_[k];
-    if (u.body >= 0) {
-      colorOf_[k] = kSerial;
-      ++count[kMaxColors];
-      continue;
-    }
-    uint64_t mask = used_[u.a];
-    if (u.b >= 0) mask |= used_[size_t(u.b)];
-    if (mask == ~uint64_t(0)) {
-      colorOf_[k] = kSerial;
-      ++count[kMaxColors];
-      continue;
-    }
-    const int c = std::countr_one(mask);
-    colorOf_[k] = uint8_t(c);
-    ++count[size_t(c)];
-    used_[u.a] |= uint64_t(1) << c;
-    if (u.b >= 0) used_[size_t(u.b)] |= uint64_t(1) << c;
+    int sl;
+    if (u.body >= 0) sl = numSlabs;  // touches a dynamic rigid body: serial
+    else if (u.b >= 0) sl = std::min(slabOfParticle(u.a), slabOfParticle(size_t(u.b)));
+    else sl = slabOfParticle(u.a);
+    slabOf_[k] = uint16_t(sl);
+    ++count[size_t(sl)];
   }
-  int numColors = 0;
-  for (int c = 0; c < kMaxColors; ++c)
-    if (count[size_t(c)] > 0) numColors = c + 1;
-  colorStart_.assign(size_t(numColors) + 1, 0);
-  for (int c = 0; c < numColors; ++c) colorStart_[size_t(c) + 1] = colorStart_[size_t(c)] + count[size_t(c)];
-  std::vector<uint32_t> cursor(colorStart_.begin(), colorStart_.end() - 1);
-  const uint32_t serialBegin = colorStart_.back();
-  uint32_t serialCursor = serialBegin;
+  slabStart_.assign(size_t(numSlabs) + 2, 0);
+  for (int sl = 0; sl <= numSlabs; ++sl) slabStart_[size_t(sl) + 1] = slabStart_[size_t(sl)] + count[size_t(sl)];
+  std::vector<uint32_t> cursor(slabStart_.begin(), slabStart_.end() - 1);
   units_.resize(nu);
-  serial_.clear();
-  for (size_t k = 0; k < nu; ++k) {
-    if (colorOf_[k] == kSerial) {
-      serial_.push_back(serialCursor);
-      units_[serialCursor++] = scratchUnits_[k];
-    } else {
-      units_[cursor[colorOf_[k]]++] = scratchUnits_[k];
-    }
-  }
+  for (size_t k = 0; k < nu; ++k) units_[cursor[slabOf_[k]]++] = scratchUnits_[k];
+  numSlabs_ = numSlabs;
 }
 
 void GranularStage::prepare(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies) {
@@ -401,28 +397,107 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
   auto& v = ps.velocities();
   auto& w = ps.angularVelocities();
   const auto& invM = ps.invMasses();
-  const int colors = int(numColors());
   Real maxDelta = 0;
-  const bool par = units_.size() > kParallelMin;
-  auto runSerial = [&] {
+  auto runRange = [&](uint32_t b0, uint32_t b1) {
+    Real md = 0;
     if (!backward)
-      for (uint32_t k : serial_) solveUnit(units_[k], v, w, invM, invInertia_, bodies, maxDelta);
+      for (uint32_t k = b0; k < b1; ++k) solveUnit(units_[k], v, w, invM, invInertia_, bodies, md);
     else
-      for (size_t j = serial_.size(); j-- > 0;) solveUnit(units_[serial_[j]], v, w, invM, invInertia_, bodies, maxDelta);
+      for (uint32_t k = b1; k-- > b0;) solveUnit(units_[k], v, w, invM, invInertia_, bodies, md);
+    return md;
   };
-  if (backward) runSerial();
-#pragma omp parallel if (par)
-  {
-    for (int ci = 0; ci < colors; ++ci) {
-      const int c = backward ? colors - 1 - ci : ci;
-      const long b0 = long(colorStart_[size_t(c)]), b1 = long(colorStart_[size_t(c) + 1]);
-      // Units of one colour share no particle, so their order (and the thread that runs them) does not matter.
-#pragma omp for schedule(static) reduction(max : maxDelta)
-      for (long k = b0; k < b1; ++k) solveUnit(units_[size_t(k)], v, w, invM, invInertia_, bodies, maxDelta);
+  const int S = numSlabs_;
+  const uint32_t serialBegin = slabStart_[size_t(S)], serialEnd = slabStart_[size_t(S) + 1];
+  if (backward) maxDelta = std::max(maxDelta, runRange(serialBegin, serialEnd));
+  if (S == 1) {
+    maxDelta = std::max(maxDelta, runRange(slabStart_[0], slabStart_[1]));
+  } else {
+    // Two phases (even slabs, then odd; reversed when sweeping backward), each slab a serial Gauss-Seidel run:
+    // slabs of one phase share no particle, so which thread runs which slab does not change any bit.
+#pragma omp parallel
+    for (int ph = 0; ph < 2; ++ph) {
+      const int parity = backward ? 1 - ph : ph;
+#pragma omp for schedule(dynamic, 1) reduction(max : maxDelta)
+      for (int j = 0; j < (S - parity + 1) / 2; ++j) {
+        const int sl = backward ? S - 1 - ((S - 1 - parity) % 2) - 2 * j : parity + 2 * j;
+        maxDelta = std::max(maxDelta, runRange(slabStart_[size_t(sl)], slabStart_[size_t(sl) + 1]));
+      }
     }
   }
-  if (!backward) runSerial();
+  if (!backward) maxDelta = std::max(maxDelta, runRange(serialBegin, serialEnd));
   return maxDelta;
+}
+
+void GranularStage::solveUnitFrozen(Unit& u, int frozen, std::vector<Vec3>& v, std::vector<Vec3>& w,
+                                    const std::vector<Real>& invM, const std::vector<Real>& invI,
+                                    const std::vector<SolverBodyState>& bodies) const {
+  // Particle p is the free side; q (particle or static geometry) is held. Directions below act on p along
+  // +d when p is side A, -d when p is side B.
+  const bool pIsA = frozen == 1;
+  const size_t p = pIsA ? u.a : size_t(u.b);
+  const Vec3& rp = pIsA ? u.ra : u.rb;
+  const Real sgn = pIsA ? 1.0 : -1.0;
+  auto relVel = [&]() -> Vec3 {
+    Vec3 vr = v[u.a] + w[u.a].cross(u.ra);
+    if (u.b >= 0) vr -= v[size_t(u.b)] + w[size_t(u.b)].cross(u.rb);
+    else if (u.body >= 0) vr -= bodies[size_t(u.body)].v + bodies[size_t(u.body)].w.cross(u.rb);
+    return vr;
+  };
+  auto kInv = [&](const Vec3& d, Real e) { return 1.0 / (invM[p] + invI[p] * rp.cross(d).squaredNorm() + e); };
+  auto applyP = [&](const Vec3& P) {  // P acts on side A
+    v[p] += sgn * invM[p] * P;
+    w[p] += sgn * invI[p] * rp.cross(P);
+  };
+  {
+    const Real vn = u.n.dot(relVel());
+    const Real nl = std::max(u.lN + (u.rhsN - vn - u.eN * u.lN) * kInv(u.n, u.eN), u.loN);
+    const Real d = nl - u.lN;
+    u.lN = nl;
+    if (d != 0) applyP(d * u.n);
+  }
+  if (u.mu > 0) {
+    const Vec3 vr = relVel();
+    Real l1 = u.lT1 + (-u.t1.dot(vr) - u.eT * u.lT1) * kInv(u.t1, u.eT);
+    Real l2 = u.lT2 + (-u.t2.dot(vr) - u.eT * u.lT2) * kInv(u.t2, u.eT);
+    const Real lim = std::isinf(u.mu) ? 1e300 : u.mu * std::max<Real>(u.lN, 0);
+    const Real mag2 = l1 * l1 + l2 * l2;
+    if (mag2 > lim * lim) {
+      const Real s = lim / std::sqrt(mag2);
+      l1 *= s;
+      l2 *= s;
+    }
+    const Real d1 = l1 - u.lT1, d2 = l2 - u.lT2;
+    u.lT1 = l1;
+    u.lT2 = l2;
+    if (d1 != 0 || d2 != 0) applyP(d1 * u.t1 + d2 * u.t2);
+  }
+}
+
+void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies, const Vec3& up,
+                              int sweeps) {
+  if (units_.empty() || sweeps <= 0) return;
+  const auto& x = ps.positions();
+  const auto& r = ps.radii();
+  shockOrder_.clear();
+  for (uint32_t k = 0; k < units_.size(); ++k) {
+    const Unit& u = units_[k];
+    if (u.kN == 0) continue;  // inert (destroyed particle)
+    if (u.b < 0) {
+      // Geometry side: only static or kinematic geometry acts as a support here (side B is never moved).
+      if (u.body >= 0 && bodies[size_t(u.body)].invMass > 0) continue;
+      shockOrder_.push_back({x[u.a].dot(up) - 2 * r[u.a], k * 2 + 1});
+      continue;
+    }
+    if (std::abs(u.n.dot(up)) <= 0.3) continue;
+    const Real ha = x[u.a].dot(up), hb = x[size_t(u.b)].dot(up);
+    // Freeze the lower particle.
+    shockOrder_.push_back(ha < hb ? std::make_pair(ha, k * 2 + 0) : std::make_pair(hb, k * 2 + 1));
+  }
+  std::sort(shockOrder_.begin(), shockOrder_.end());
+  auto& v = ps.velocities();
+  auto& w = ps.angularVelocities();
+  for (int s = 0; s < sweeps; ++s)
+    for (const auto& [h, code] : shockOrder_) solveUnitFrozen(units_[code >> 1], int(code & 1), v, w, ps.invMasses(), invInertia_, bodies);
 }
 
 void GranularStage::integrate(GranularBodySystem& ps, Real h, std::vector<size_t>& outNonFinite,
@@ -473,9 +548,9 @@ void GranularStage::storeResults(const GranularBodySystem& ps, Real h) {
     if (u.b >= 0) {
       const uint64_t sb = slotKey(ps.idOfDense(size_t(u.b)));
       const Real s = u.flip ? -1.0 : 1.0;
-      nextPp_.push_back({u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0, u.lN, s * F, s * T});
+      nextPp_.push_back({u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0, u.lN, s * F, s * T, u.impact});
     } else {
-      nextPg_.push_back({sa << 32 | c.geometry->getId(), c.featureId, u.lN, F, T});
+      nextPg_.push_back({sa << 32 | c.geometry->getId(), c.featureId, u.lN, F, T, u.impact});
     }
   }
   std::sort(nextPp_.begin(), nextPp_.end());

@@ -12,12 +12,15 @@
 //              step. Warm start from last step's impulses keyed by particle slots (stable across destroy of
 //              other particles and reorder) and geometry id + feature.
 //              Then the free velocities: v += h g.
-//   sweep      one projected Gauss-Seidel sweep. Units touching only particles (and static or kinematic
-//              geometry) are graph-coloured greedily in list order so that no two units of one colour share a
-//              particle; a colour is solved in parallel (OpenMP). Units touching a dynamic rigid body, and the
-//              colour overflow (> 63 colours), are solved serially after the colours. Within a colour no two
-//              units touch the same particle, so the result is bit-identical for any thread count.
-//              Sweeps alternate forward / backward over the colours (symmetric Gauss-Seidel, as the rigid PGS).
+//   sweep      one projected Gauss-Seidel sweep, parallel by a two-colouring of spatial slabs: the cloud is cut
+//              into up to 64 slabs along its longest axis, each at least one grid cell wide, and a unit belongs
+//              to the lower slab of its particles, so units of different even slabs (or odd slabs) never share
+//              a particle. Even slabs run in parallel (OpenMP, one thread per slab, serial Gauss-Seidel inside),
+//              then odd slabs; units touching a dynamic rigid body run serially last. The partition depends on
+//              positions only, so results are bit-identical for any thread count, and a sweep costs two
+//              barriers (a greedy per-contact colouring needed ~20, which on a shared, oversubscribed machine
+//              cost more than the sweep). Small or narrow systems (< 4 slabs or < 2048 units) run serially.
+//              Sweeps alternate forward / backward (symmetric Gauss-Seidel, as the rigid PGS).
 //   integrate  x += h v for live particles; a particle whose velocity or position turns non-finite is
 //              reported by id, keeps its last position and is stopped.
 //   store      forces into the contact lists, impulses into the warm-start cache.
@@ -51,8 +54,14 @@ class GranularStage {
   void prepare(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies);
   /// One sweep; `backward` reverses the order. Returns the largest |delta lambda|.
   Real sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies, bool backward);
+  /// Shock propagation for piles (Guendelman, Bridson & Fedkiw 2003, as the rigid PgsSolver::shockPass): the
+  /// units whose normal has a component along `up` (|n . up| > 0.3), and particle contacts with static or
+  /// kinematic geometry, are solved once more in order of the height of their lower side, each with the
+  /// lower particle held immovable, so a column's weight is carried from the ground up within one step
+  /// instead of being propagated by a few Gauss-Seidel sweeps. Serial (deterministic). `sweeps` passes.
+  void shockPass(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies, const Vec3& up, int sweeps);
   /// True when some particle touches a dynamic rigid body (then Simulation interleaves the rigid sweeps).
-  bool coupled() const { return !serial_.empty(); }
+  bool coupled() const { return !slabStart_.empty() && slabStart_.back() > slabStart_[size_t(numSlabs_)]; }
   bool hasUnits() const { return !units_.empty(); }
   /// Positions; non-finite particles are appended to outNonFinite (ids) with a message each.
   void integrate(GranularBodySystem& ps, Real h, std::vector<size_t>& outNonFinite, std::vector<std::string>& outMessages,
@@ -62,7 +71,7 @@ class GranularStage {
   const std::vector<ParticleContact>& particleParticleContacts() const { return collider_.getParticleParticleContacts(); }
   const std::vector<ParticleContact>& particleGeometryContacts() const { return collider_.getParticleGeometryContacts(); }
   size_t numUnits() const { return units_.size(); }
-  size_t numColors() const { return colorStart_.empty() ? 0 : colorStart_.size() - 1; }
+  int numSlabs() const { return numSlabs_; }
 
  private:
   // One contact point between particle a and particle b or a geometry (its rigid body index `body`, -1 none).
@@ -76,6 +85,7 @@ class GranularStage {
     Real kN = 0, kT1 = 0, kT2 = 0, kR = 0;     // 1 / (J M^-1 J^T + e) of normal, tangents, rolling
     Real rhsN = 0, eN = 0, loN = 0, eT = 0, mu = 0, rollMu = 0;
     Real lN = 0, lT1 = 0, lT2 = 0, lR1 = 0, lR2 = 0;
+    Real impact = 0;      // approach speed of a speculative stop this step, remembered for next step's bounce
     bool flip = false;    // a's slot is the higher one of the pair (warm-start vectors are stored for the lower)
   };
   struct CacheEntry {
@@ -83,22 +93,26 @@ class GranularStage {
     uint32_t feature;
     Real normal;
     Vec3 friction, rolling;  // on the lower slot (pp) or on the particle (pg)
+    Real impact;
     bool operator<(const CacheEntry& o) const { return key != o.key ? key < o.key : feature < o.feature; }
   };
   const CacheEntry* find(const std::vector<CacheEntry>& cache, uint64_t key, uint32_t feature) const;
   void solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& w, const std::vector<Real>& invM,
                  const std::vector<Real>& invI, std::vector<SolverBodyState>& bodies, Real& maxDelta) const;
-  void color(size_t numParticles);
+  void partition(const GranularBodySystem& ps);
+  /// One update of u with side A (frozen = 0) or B (frozen = 1) held immovable.
+  void solveUnitFrozen(Unit& u, int frozen, std::vector<Vec3>& v, std::vector<Vec3>& w, const std::vector<Real>& invM,
+                       const std::vector<Real>& invI, const std::vector<SolverBodyState>& bodies) const;
 
   ParticleCollider collider_;
   uint64_t stepCount_ = 0;
   std::vector<Unit> units_;          // all units, the parallel ones grouped by colour first
-  std::vector<uint32_t> colorStart_; // [numColors + 1] ranges into units_
-  std::vector<uint32_t> serial_;     // units solved serially (dynamic bodies, colour overflow), in list order
+  std::vector<uint32_t> slabStart_;  // [numSlabs + 2] ranges into units_; the last range is the serial set
+  int numSlabs_ = 1;
   std::vector<Real> invInertia_;     // [size()] 1 / (0.4 m r^2)
-  std::vector<uint64_t> used_;       // colouring scratch, per particle
   std::vector<Unit> scratchUnits_;
-  std::vector<uint8_t> colorOf_;
+  std::vector<uint16_t> slabOf_;
+  std::vector<std::pair<Real, uint32_t>> shockOrder_;  // (height of the lower side, unit * 2 + frozen side)
   std::vector<CacheEntry> ppCache_, pgCache_, nextPp_, nextPg_;
 };
 

@@ -671,6 +671,8 @@ void Simulation::solve() {
     if (particles)
       for (int it = 0; it < iterations; ++it) residual = std::max(residual, m.granular.sweep(granular_, m.sb, it % 2 == 1));
   }
+  if (particles && solver_.getUseShockPropagation() && gravity_.squaredNorm() > 0)
+    m.granular.shockPass(granular_, m.sb, -gravity_.normalized(), 2);
   solver_.stats().lastResidual = residual;
   solver_.stats().numIterations = size_t(iterations);
   if (!m.rows.empty() && solver_.getUseShockPropagation() && !m.contactRanges.empty()) {

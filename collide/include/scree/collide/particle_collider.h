@@ -47,6 +47,9 @@ class ParticleCollider {
   const std::vector<ParticleContact>& getParticleGeometryContacts() const { return pg_; }
   std::vector<ParticleContact>& getParticleGeometryContacts() { return pg_; }
 
+  /// Grid cell size of the last collide(), m: no particle pair in contact is farther apart than this.
+  Real getCellSize() const;
+
   /// A permutation (for GranularBodySystem::reorder) that sorts particles along the grid (cells in z, y, x
   /// order), so neighbours in space are near in memory. Uses the grid of the last collide().
   std::vector<uint32_t> localityOrder(const GranularBodySystem& ps) const;

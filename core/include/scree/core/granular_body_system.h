@@ -105,6 +105,12 @@ class GranularBodySystem {
       if (alive_[i]) f(idOfDense(i));
     endDeferral();
   }
+  /// Read-only iteration: f(id) for every live particle, in dense order.
+  template <class F>
+  void forEachParticle(F&& f) const {
+    for (size_t i = 0; i < size(); ++i)
+      if (alive_[i]) f(idOfDense(i));
+  }
   /// Ids of the live particles, in dense order.
   std::vector<size_t> getParticleIds() const;
 
