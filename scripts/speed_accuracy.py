@@ -2,7 +2,9 @@
 """Turns bench_tradeoff's JSON output into the generated part of docs/speed-accuracy.md and one PNG per scene.
 
     build/bench/bench_tradeoff --benchmark_format=json --benchmark_out=tradeoff.json
-    python3 scripts/speed_accuracy.py tradeoff.json [docs/speed-accuracy.md]
+    python3 scripts/speed_accuracy.py tradeoff.json [more.json ...] [--doc docs/speed-accuracy.md]
+
+Several JSON files (e.g. runs of different scenes with --benchmark_filter) are merged.
 
 The Markdown file keeps everything outside the markers <!-- BEGIN GENERATED --> / <!-- END GENERATED -->; the
 tables, Pareto fronts and plot links between them are rewritten. Plots need gnuplot (Debian: gnuplot-nox,
@@ -141,10 +143,15 @@ def generate(rows, docdir):
 
 
 def main():
-    src = sys.argv[1]
-    doc = sys.argv[2] if len(sys.argv) > 2 else os.path.join(os.path.dirname(__file__), "..", "docs",
-                                                             "speed-accuracy.md")
-    rows = load(src)
+    args = sys.argv[1:]
+    doc = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "speed-accuracy.md")
+    if "--doc" in args:
+        i = args.index("--doc")
+        doc = args[i + 1]
+        del args[i:i + 2]
+    rows = []
+    for src in args:
+        rows += load(src)
     body = generate(rows, os.path.dirname(os.path.abspath(doc)))
     text = open(doc).read() if os.path.exists(doc) else "<!-- BEGIN GENERATED -->\n<!-- END GENERATED -->\n"
     begin, end = "<!-- BEGIN GENERATED -->", "<!-- END GENERATED -->"
