@@ -69,15 +69,19 @@ def plot(scene, rows, outdir):
     if not shutil.which("gnuplot"):
         return None
     os.makedirs(outdir, exist_ok=True)
-    dat = os.path.join(outdir, scene + ".dat")
-    with open(dat, "w") as f:
-        for t in ["PGS", "SPLIT", "DIRECT"]:
-            for r in rows:
-                if r["type"] == t:
-                    f.write("%g %g\n" % (r["cost"], max(min(r["error"], 1e3), 1e-9)))
-            f.write("\n\n")
-        for r in pareto(rows):
-            f.write("%g %g\n" % (r["cost"], max(min(r["error"], 1e3), 1e-9)))
+    series, files = [], []
+    styles = {"PGS": "with points pt 7", "SPLIT": "with points pt 5", "DIRECT": "with points pt 9 ps 1.5",
+              "Pareto front": "with lines lw 2"}
+    for t in ["PGS", "SPLIT", "DIRECT", "Pareto front"]:
+        pts = pareto(rows) if t == "Pareto front" else [r for r in rows if r["type"] == t]
+        if not pts:
+            continue
+        dat = os.path.join(outdir, "%s.%s.dat" % (scene, t.split()[0]))
+        with open(dat, "w") as f:
+            for r in pts:
+                f.write("%g %g\n" % (r["cost"], max(min(r["error"], 1e3), 1e-9)))
+        files.append(dat)
+        series.append("'%s' %s title '%s'" % (dat, styles[t], t))
     png = os.path.join(outdir, scene + ".png")
     limit = USABLE[scene][0]
     script = f"""
@@ -89,11 +93,11 @@ set ylabel 'error (m)'
 set title '{scene}: error against cost (dt 1/30 .. 1/240, 5 .. 200 iterations)'
 set key outside right
 set arrow from graph 0, first {limit} to graph 1, first {limit} nohead dt 2
-plot '{dat}' index 0 with points pt 7 title 'PGS', '' index 1 with points pt 5 title 'SPLIT', \
-     '' index 2 with points pt 9 ps 1.5 title 'DIRECT', '' index 3 with lines lw 2 title 'Pareto front'
+plot {", ".join(series)}
 """
     subprocess.run(["gnuplot"], input=script, text=True, check=True)
-    os.remove(dat)
+    for dat in files:
+        os.remove(dat)
     return png
 
 
