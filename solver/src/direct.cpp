@@ -442,7 +442,10 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
         moved = std::max({moved, std::abs(m.lo[k] - usedLo[k]), std::abs(m.hi[k] - usedHi[k])});
     }
     if (moved <= 1e-10 * scale) converged = true;
-    // Held rows sit on the new bounds; free rows now outside them are held at the nearer one.
+    // Held rows sit on the new bounds (rows held at a degenerate bound lo = hi, friction without normal force,
+    // start free); free rows now outside them are held at the nearer one.
+    for (int k = 0; k < n; ++k)
+      if (m.state[k] != 0 && m.normalLocal[k] >= 0 && usedLo[k] == usedHi[k]) m.state[k] = 0;
     for (int k = 0; k < n; ++k)
       if (m.state[k] == 0 && (m.lam[k] < m.lo[k] || m.lam[k] > m.hi[k])) {
         m.state[k] = m.lam[k] < m.lo[k] ? -1 : 1;

@@ -38,9 +38,10 @@ class FrictionModel {
  public:
   /// Where a contact's rows are solved. DIRECT: normal and friction in the direct solver. ITERATIVE: PGS.
   /// DIRECT_AND_ITERATIVE / SPLIT: normals in the direct set, friction iteratively (SPLIT solves the normals
-  /// directly once more after the iterative friction pass). Until the direct solver lands, every type is solved
-  /// by PGS and a one-time warning is logged for non-ITERATIVE rows; the default is therefore ITERATIVE for
-  /// now (AGX ships SPLIT for contacts; the DIRECT issue revisits the default with measurements).
+  /// directly once more after the iterative friction pass; DIRECT_AND_ITERATIVE lets PGS sweep the direct rows
+  /// too). Default ITERATIVE for contacts: PGS with shock propagation holds the reference stacks for a fraction
+  /// of the direct cost (AGX ships SPLIT; measurements in docs/speed-accuracy.md). Without SuiteSparse every
+  /// type is solved by PGS and a one-time warning is logged.
   enum SolveType { DIRECT = 0, ITERATIVE = 1, DIRECT_AND_ITERATIVE = 2, SPLIT = 3 };
   /// BOX: bounds mu * (normal force estimated from last step, or the body weight for a new contact).
   /// SCALED_BOX: bounds mu * (current normal impulse iterate), per direction.

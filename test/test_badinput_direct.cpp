@@ -1,0 +1,45 @@
+// Bad input for the DIRECT solver's settings: std::invalid_argument naming the parameter and the value, the
+// solver unchanged.
+#include <doctest/doctest.h>
+
+#include <string>
+
+#include <scree/scree.h>
+#include <scree/solver/direct.h>
+
+using namespace scree;
+
+namespace {
+template <class F>
+void expectInvalid(F&& f, const std::string& param, const std::string& value) {
+  try {
+    f();
+    FAIL("no exception for " << param);
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    INFO(what);
+    CHECK(what.find(param) != std::string::npos);
+    CHECK(what.find(value) != std::string::npos);
+  }
+}
+}  // namespace
+
+TEST_CASE("Solver: pivot cap and hybrid rounds must be >= 1") {
+  Solver s;
+  s.setMaxPivots(7);
+  s.setNumHybridRounds(3);
+  expectInvalid([&] { s.setMaxPivots(0); }, "maxPivots", "0");
+  expectInvalid([&] { s.setMaxPivots(-5); }, "maxPivots", "-5");
+  expectInvalid([&] { s.setNumHybridRounds(0); }, "numHybridRounds", "0");
+  CHECK(s.getMaxPivots() == 7);
+  CHECK(s.getNumHybridRounds() == 3);
+}
+
+TEST_CASE("DirectSolver: an empty set is a no-op") {
+  DirectSolver d;
+  std::vector<ConstraintRow> rows(2);
+  std::vector<SolverBodyState> bodies(1);
+  const auto r = d.solve(rows, {}, bodies, DirectSolver::Settings{});
+  CHECK(r.factorisations == 0);
+  CHECK(r.converged);
+}
