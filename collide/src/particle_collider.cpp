@@ -18,6 +18,12 @@ namespace {
 // thread count.
 constexpr size_t kChunk = 512;
 
+// Cell coordinate of a position component; clamped so that a particle far away (1e9 cells) cannot overflow
+// the integer conversion (it only shares a cell with other far-away particles).
+inline int32_t cellCoord(Real x, Real invCell) {
+  return int32_t(std::clamp<Real>(std::floor(x * invCell), -1e9, 1e9));
+}
+
 inline uint64_t hashCell(int64_t x, int64_t y, int64_t z) {
   return uint64_t(x) * 73856093ull ^ uint64_t(y) * 19349663ull ^ uint64_t(z) * 83492791ull;
 }
@@ -94,9 +100,9 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
   m.bucketOf.resize(n);
 #pragma omp parallel for schedule(static)
   for (size_t i = 0; i < n; ++i) {
-    m.cx[i] = int32_t(std::floor(x[i].x() * m.invCell));
-    m.cy[i] = int32_t(std::floor(x[i].y() * m.invCell));
-    m.cz[i] = int32_t(std::floor(x[i].z() * m.invCell));
+    m.cx[i] = cellCoord(x[i].x(), m.invCell);
+    m.cy[i] = cellCoord(x[i].y(), m.invCell);
+    m.cz[i] = cellCoord(x[i].z(), m.invCell);
     m.bucketOf[i] = uint32_t(hashCell(m.cx[i], m.cy[i], m.cz[i]) & m.tableMask);
   }
   m.bucketStart.assign(table + 1, 0);
@@ -188,9 +194,9 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
     auto& cand = m.candidates;
     cand.clear();
     if (cells.x() * cells.y() * cells.z() < Real(n)) {
-      const int64_t x0 = int64_t(std::floor(clip.lo.x() * m.invCell)), x1 = int64_t(std::floor(clip.hi.x() * m.invCell));
-      const int64_t y0 = int64_t(std::floor(clip.lo.y() * m.invCell)), y1 = int64_t(std::floor(clip.hi.y() * m.invCell));
-      const int64_t z0 = int64_t(std::floor(clip.lo.z() * m.invCell)), z1 = int64_t(std::floor(clip.hi.z() * m.invCell));
+      const int64_t x0 = cellCoord(clip.lo.x(), m.invCell), x1 = cellCoord(clip.hi.x(), m.invCell);
+      const int64_t y0 = cellCoord(clip.lo.y(), m.invCell), y1 = cellCoord(clip.hi.y(), m.invCell);
+      const int64_t z0 = cellCoord(clip.lo.z(), m.invCell), z1 = cellCoord(clip.hi.z(), m.invCell);
       for (int64_t cz = z0; cz <= z1; ++cz)
         for (int64_t cy = y0; cy <= y1; ++cy)
           for (int64_t cx = x0; cx <= x1; ++cx) m.forCell(cx, cy, cz, [&](uint32_t j) { cand.push_back(j); });
