@@ -56,7 +56,7 @@ class DirectSolver {
     double factorSeconds = 0;
   };
   /// AUTO picks KKT when nnz(Schur) > kktRatio * nnz(KKT) (upper triangles).
-  static constexpr Real kktRatio = 2.0;
+  static constexpr Real kktRatio = 1.0;
 
   DirectSolver();
   ~DirectSolver();
