@@ -453,14 +453,25 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
       }
   }
   res.converged = converged;
-
-  // Clamp (pivot cap or factorisation failure). Projected-cone pairs stay a scaled box here: projecting them
-  // onto the disc afterwards would break the solution's complementarity.
-  updateBounds();
-  for (int k = 0; k < n; ++k) {
-    if (!std::isfinite(m.lam[k])) m.lam[k] = m.lamOld[k], res.converged = false;
-    m.lam[k] = std::clamp(m.lam[k], m.lo[k], m.hi[k]);
+  if (!converged) {
+    // Pivot cap or factorisation failure: an intermediate active set can be far from the solution (impulses of
+    // rows held at the wrong bound), so nothing is written back; the caller solves the set from the impulses it
+    // came with (warm start).
+    m.lam = m.lamOld;
+    m.state.assign(n, 0);
+    updateBounds();
+    computeW();
+    Real resid = 0;
+    for (int k = 0; k < n; ++k)
+      resid = std::max(resid, std::abs(m.lam[k] - std::clamp(m.lam[k] - m.w[k] / m.ad[k], m.lo[k], m.hi[k])));
+    res.residual = resid;
+    return res;
   }
+
+  // Projected-cone pairs stay a scaled box here: projecting them onto the disc afterwards would break the
+  // solution's complementarity.
+  updateBounds();
+  for (int k = 0; k < n; ++k) m.lam[k] = std::clamp(m.lam[k], m.lo[k], m.hi[k]);
   computeW();
   Real resid = 0;
   for (int k = 0; k < n; ++k) {

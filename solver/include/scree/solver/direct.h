@@ -47,7 +47,7 @@ class DirectSolver {
     int maxPivots = 50;
   };
   struct Result {
-    bool converged = true;         ///< false: pivot cap hit (lambda holds the last iterate, clamped to its bounds)
+    bool converged = true;         ///< false: pivot cap hit or not definite (impulses and velocities unchanged)
     int factorisations = 0;
     int pivots = 0;                ///< active-set changes
     int symbolicAnalyses = 0;      ///< 0 when the cached analysis was reused
@@ -56,7 +56,7 @@ class DirectSolver {
     double factorSeconds = 0;
   };
   /// AUTO picks KKT when nnz(Schur) > kktRatio * nnz(KKT) (upper triangles).
-  static constexpr Real kktRatio = 2.0;
+  static constexpr Real kktRatio = 1.0;
 
   DirectSolver();
   ~DirectSolver();

@@ -33,7 +33,7 @@ class Solver {
  public:
   /// Matrix form of the DIRECT solve (DESIGN.md §4). SCHUR: A = G M^-1 G^T + E, CHOLMOD LL^T. KKT: the
   /// quasi-definite [M -G^T; -G -E], CHOLMOD LDL^T without pivoting. AUTO: KKT when the Schur matrix would have
-  /// more nonzeros than KKT_RATIO times the KKT matrix (bodies carrying many rows), else SCHUR (see
+  /// more nonzeros than DirectSolver::kktRatio (1) times the KKT matrix (bodies carrying many rows), else SCHUR (see
   /// docs/speed-accuracy.md for the measurements behind it).
   enum DirectForm { AUTO = 0, SCHUR = 1, KKT = 2 };
 
