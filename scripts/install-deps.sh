@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages Scree's build needs, only those that are missing.
 #
-#   bash scripts/install-deps.sh [--with-plot] [--check]
+#   bash scripts/install-deps.sh [--with-plot] [--with-bullet] [--check]
 #
 #   --with-plot  also gnuplot-nox (plots of the benchmark sweeps; the build does not need it)
+#   --with-bullet  also libbullet-dev (the optional side-by-side benchmark bench_bullet_granular)
 #   --check      only report what is missing; exit 1 if something is
 #
 # As root: `apt-get update` (only when something is missing) and
@@ -18,8 +19,9 @@ check_only=0
 for arg in "$@"; do
   case "$arg" in
     --with-plot) packages+=(gnuplot-nox) ;;
+    --with-bullet) packages+=(libbullet-dev) ;;
     --check) check_only=1 ;;
-    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "install-deps.sh: unknown option '$arg' (try --help)" >&2; exit 2 ;;
   esac
 done
