@@ -2,6 +2,7 @@
 // solver unchanged.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <string>
 
 #include <scree/scree.h>
@@ -33,6 +34,18 @@ TEST_CASE("Solver: pivot cap and hybrid rounds must be >= 1") {
   expectInvalid([&] { s.setNumHybridRounds(0); }, "numHybridRounds", "0");
   CHECK(s.getMaxPivots() == 7);
   CHECK(s.getNumHybridRounds() == 3);
+}
+
+TEST_CASE("Solver: position projection iterations >= 1, tolerance > 0 and finite") {
+  Solver s;
+  s.setNumProjectionIterations(5);
+  s.setPositionProjectionTolerance(1e-4);
+  expectInvalid([&] { s.setNumProjectionIterations(0); }, "numProjectionIterations", "0");
+  expectInvalid([&] { s.setPositionProjectionTolerance(0); }, "tolerance", "0");
+  expectInvalid([&] { s.setPositionProjectionTolerance(-1); }, "tolerance", "-1");
+  expectInvalid([&] { s.setPositionProjectionTolerance(std::nan("")); }, "tolerance", "nan");
+  CHECK(s.getNumProjectionIterations() == 5);
+  CHECK(s.getPositionProjectionTolerance() == 1e-4);
 }
 
 TEST_CASE("DirectSolver: an empty set is a no-op") {

@@ -99,6 +99,8 @@ void Joint::finishRow(const ConstraintContext& ctx, ConstraintRow& r, int dof, R
   r.e = co.e;
   r.lambda = warm_[dof];
   r.solveType = solveType_;
+  r.holonomic = true;
+  r.drift = g + compliance * warm_[dof] / ctx.h;
 }
 
 void Joint::pushLinear(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& dofs, int dof,

@@ -24,6 +24,17 @@ void Solver::setNumHybridRounds(int n) {
   hybridRounds_ = n;
 }
 
+void Solver::setNumProjectionIterations(int n) {
+  if (n < 1)
+    detail::throwInvalid("Solver::setNumProjectionIterations", "numProjectionIterations", (long long)n, "must be >= 1");
+  projectionIterations_ = n;
+}
+
+void Solver::setPositionProjectionTolerance(Real tol) {
+  detail::requirePositive("Solver::setPositionProjectionTolerance", "tolerance", tol);
+  projectionTolerance_ = tol;
+}
+
 void Solver::setRestitutionThreshold(Real v) {
   detail::requireNonNegative("Solver::setRestitutionThreshold", "threshold", v);
   restitutionThreshold_ = v;

@@ -31,6 +31,11 @@ struct ConstraintRow {
   /// Lever arms |r| from each body's centre of mass to the point the row acts at (joints' linear rows), m; used
   /// for the geometric-stiffness term of the direct solve (Simulation::solve). 0: none.
   Real leverA = 0, leverB = 0;
+  /// Holonomic equality rows of a joint's own DOFs (not controllers): the position drift g + eps * f, the part of the position
+  /// error g that the elastic stretch of the last force f (compliance eps) does not account for, in m or rad.
+  /// Read by the post-step position projection (Solver::setUsePositionProjection). 0 for other rows.
+  Real drift = 0;
+  bool holonomic = false;
 
   // Filled by the solver's prepare step.
   Vec3 mJLinA = Vec3::Zero(), mJAngA = Vec3::Zero(), mJLinB = Vec3::Zero(), mJAngB = Vec3::Zero();  ///< M^-1 J^T

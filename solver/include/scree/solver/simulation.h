@@ -115,6 +115,8 @@ class Simulation {
   void runPost();
   void storeContactResults();
   void checkFinite();
+  void projectPositions();
+  bool computeGeometricStiffness();
   int solverIndex(const RigidBody* b) const;
 
   Real h_ = 1.0 / 60.0;
