@@ -134,6 +134,45 @@ TEST_CASE("the position projection leaves motion within its tolerance to SPOOK")
   CHECK(lossTight > lossOff + 0.1);  // 5 s at (omega h)^2 ~ 1e-3 per step of ~5 J: ~0.5 J
 }
 
+TEST_CASE("a PGS chain that comes apart is reported, not silent") {
+  // chain20 hanging with PGS at 10 iterations diverges to ~1e11 m while staying finite. The step report names
+  // the joints whose error beyond the elastic stretch exceeds the threshold (0.1 m), and each is logged once as
+  // an error naming the joint and its solve type. DIRECT keeps every joint at its 1.2e-5 m stretch: no report.
+  std::vector<std::string> errors;
+  Logger::setSink([&](LogLevel l, const std::string& msg) {
+    if (l == LogLevel::ERROR) errors.push_back(msg);
+  });
+  for (auto t : {FrictionModel::ITERATIVE, FrictionModel::DIRECT}) {
+    errors.clear();
+    scenes::Chain20Scene s = scenes::buildChain20(100.0, true);
+    s.sim->getSolver().setNumIterations(10);
+    for (auto& j : s.joints) j->setSolveType(t);
+    s.joints.front()->setName("pivot");
+    size_t firstReported = 0, maxListed = 0;
+    for (int i = 0; i < 600; ++i) {
+      s.sim->stepForward();
+      const auto& rep = s.sim->getLastStepReport();
+      if (!rep.separatedConstraints.empty() && firstReported == 0) firstReported = size_t(i);
+      maxListed = std::max(maxListed, rep.separatedConstraints.size());
+    }
+    std::printf("%s hanging chain: first report at step %zu, up to %zu joints listed, %zu errors logged\n",
+                t == FrictionModel::DIRECT ? "DIRECT" : "PGS", firstReported, maxListed, errors.size());
+    if (t == FrictionModel::ITERATIVE) {
+      CHECK(maxListed > 0);
+      CHECK(!s.sim->getLastStepReport().ok());
+      CHECK(errors.size() <= s.joints.size());  // once per constraint, not once per step
+      REQUIRE(!errors.empty());
+      CHECK(errors.front().find("BallJoint") != std::string::npos);
+      CHECK(errors.front().find("ITERATIVE") != std::string::npos);
+    } else {
+      CHECK(maxListed == 0);
+      CHECK(errors.empty());
+      CHECK(s.sim->getLastStepReport().ok());
+    }
+  }
+  Logger::setSink(nullptr);
+}
+
 TEST_CASE("1000 kg box on a 1 kg box: DIRECT penetrations are the compliance-predicted ones") {
   // Each interface carries the weight above it over 4 corner points with stiffness E per point (the scene's
   // contact material: two default 4e8 N/m materials in series, 2e8 N/m): at rest SPOOK settles at depth

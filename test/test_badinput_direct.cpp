@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <scree/scree.h>
@@ -36,7 +37,7 @@ TEST_CASE("Solver: pivot cap and hybrid rounds must be >= 1") {
   CHECK(s.getNumHybridRounds() == 3);
 }
 
-TEST_CASE("Solver: position projection iterations >= 1, tolerance > 0 and finite") {
+TEST_CASE("Solver: position projection iterations >= 1, tolerance > 0 and finite, error threshold > 0") {
   Solver s;
   s.setNumProjectionIterations(5);
   s.setPositionProjectionTolerance(1e-4);
@@ -44,6 +45,11 @@ TEST_CASE("Solver: position projection iterations >= 1, tolerance > 0 and finite
   expectInvalid([&] { s.setPositionProjectionTolerance(0); }, "tolerance", "0");
   expectInvalid([&] { s.setPositionProjectionTolerance(-1); }, "tolerance", "-1");
   expectInvalid([&] { s.setPositionProjectionTolerance(std::nan("")); }, "tolerance", "nan");
+  s.setConstraintErrorThreshold(0.5);
+  s.setConstraintErrorThreshold(std::numeric_limits<Real>::infinity());  // off
+  expectInvalid([&] { s.setConstraintErrorThreshold(0); }, "threshold", "0");
+  expectInvalid([&] { s.setConstraintErrorThreshold(std::nan("")); }, "threshold", "nan");
+  CHECK(std::isinf(s.getConstraintErrorThreshold()));
   CHECK(s.getNumProjectionIterations() == 5);
   CHECK(s.getPositionProjectionTolerance() == 1e-4);
 }

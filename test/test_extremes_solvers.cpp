@@ -96,7 +96,7 @@ TEST_CASE("mass ratio up to 1:1e6 in a chain, and a 100-link chain") {
   // that stretch (1 %) up to 1:1e4. At 1:1e6 the stretch is 9.8 cm per joint on 20 cm links: the chain is a
   // column of soft springs released unstretched, which rings (measured 0.14 m after 10 s); bound: twice the
   // static stretch, the overshoot of a suddenly applied load. PGS at 10 iterations comes apart already at 1:100
-  // (recorded; it must stay finite or be reported).
+  // (recorded; it must hold or be reported in StepReport::separatedConstraints).
   struct Case {
     int links;
     Real M;
@@ -113,7 +113,13 @@ TEST_CASE("mass ratio up to 1:1e6 in a chain, and a 100-link chain") {
       } else if (t == FrictionModel::DIRECT) {
         CHECK(err < 2 * stretch);
       } else {
-        CHECK((scenes::allFinite(*ch.s->sim) || !ch.s->sim->getLastStepReport().ok()));
+        // Not a silent blow-up: a chain that held stays finite and below the report threshold (0.1 m); one that
+        // came apart is named in the step report (and was logged).
+        const StepReport& rep = ch.s->sim->getLastStepReport();
+        const bool held = scenes::allFinite(*ch.s->sim) && err < ch.s->sim->getSolver().getConstraintErrorThreshold();
+        CHECK((held || !rep.separatedConstraints.empty() || !rep.nonFiniteBodies.empty()));
+        if (!held) std::printf("  reported: %zu constraints apart; %s\n", rep.separatedConstraints.size(),
+                               rep.messages.empty() ? "(logged in an earlier step)" : rep.messages.front().c_str());
       }
     }
 }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <unordered_set>
 
 #include "body_access.h"
 #include "granular_stage.h"
@@ -105,6 +106,7 @@ struct Simulation::Impl {
   std::vector<int> projDofs;
   std::vector<uint32_t> projSet;
   std::vector<SolverBodyState> projBodies;
+  std::unordered_set<const Constraint*> reportedSeparated;  // separated constraints already logged
 
   const CacheEntry* find(uint64_t pair, uint32_t feature) const {
     CacheEntry key{pair, feature, 0, Vec3::Zero(), 0};
@@ -208,6 +210,7 @@ bool Simulation::remove(const ConstraintRef& c) {
   if (it == constraints_.end()) return false;
   c->removeNotification(*this);
   constraints_.erase(it);
+  impl_->reportedSeparated.erase(c.get());
   // Re-enable the pair unless another constraint still joins the same bodies without collisions.
   bool stillJoined = false;
   for (const auto& o : constraints_)
@@ -631,6 +634,7 @@ void Simulation::buildRows() {
   }
 
   // Constraints (joints, models).
+  const Real errorThreshold = solver_.getConstraintErrorThreshold();
   m.ranges.clear();
   m.rowDofs.assign(m.rows.size(), -1);
   for (auto& c : constraints_) {
@@ -645,6 +649,12 @@ void Simulation::buildRows() {
     const uint32_t begin = uint32_t(m.rows.size());
     c->addRows(ctx, m.rows, m.rowDofs);
     if (c->getSolveType() != FrictionModel::ITERATIVE) nonIterative = true;
+    // A joint that came apart: its rows' drift (position error beyond the elastic stretch of the last force)
+    // is known here for free. Reported in the step report and logged once per constraint.
+    Real drift = 0;
+    for (size_t k = begin; k < m.rows.size(); ++k)
+      if (m.rows[k].holonomic) drift = std::max(drift, std::abs(m.rows[k].drift));
+    if (!(drift <= errorThreshold)) reportSeparated(*c, drift);
     m.ranges.push_back({c.get(), begin, uint32_t(m.rows.size() - begin)});
     // Joints couple bodies for support levels too (a chain hanging from the world is supported link by link).
     m.contactRanges.push_back({ctx.indexA, ctx.indexB, begin, uint32_t(m.rows.size() - begin), true});
@@ -1061,6 +1071,24 @@ void Simulation::projectPositions() {
       s.w.setZero();
     }
   }
+}
+
+void Simulation::reportSeparated(const Constraint& c, Real drift) {
+  Impl& m = *impl_;
+  report_.separatedConstraints.push_back(&c);
+  if (!m.reportedSeparated.insert(&c).second) return;
+  static const char* kTypes[] = {"DIRECT", "ITERATIVE", "DIRECT_AND_ITERATIVE", "SPLIT"};
+  const int t = int(c.getSolveType());
+  std::ostringstream msg;
+  msg << c.getTypeName() << " \"" << c.getName() << "\" came apart at t = " << time_ << " s: position error "
+      << drift << " (m or rad) beyond its elastic stretch, above Solver::getConstraintErrorThreshold() = "
+      << solver_.getConstraintErrorThreshold() << "; solve type " << (t >= 0 && t < 4 ? kTypes[t] : "?")
+      << (c.getSolveType() == FrictionModel::ITERATIVE
+              ? " (PGS cannot hold heavy loads on light links: use DIRECT or DIRECT_AND_ITERATIVE)"
+              : " (try a smaller time step)")
+      << ". Reported once per constraint; StepReport::separatedConstraints lists it every step.";
+  report_.messages.push_back(msg.str());
+  Logger::error(msg.str());
 }
 
 void Simulation::checkFinite() {

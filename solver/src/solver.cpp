@@ -35,6 +35,11 @@ void Solver::setPositionProjectionTolerance(Real tol) {
   projectionTolerance_ = tol;
 }
 
+void Solver::setConstraintErrorThreshold(Real e) {
+  if (!(e > 0)) detail::throwInvalid("Solver::setConstraintErrorThreshold", "threshold", e, "must be > 0 (may be infinite)");
+  constraintErrorThreshold_ = e;
+}
+
 void Solver::setRestitutionThreshold(Real v) {
   detail::requireNonNegative("Solver::setRestitutionThreshold", "threshold", v);
   restitutionThreshold_ = v;

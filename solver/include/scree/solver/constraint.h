@@ -34,6 +34,8 @@ class Constraint {
   RigidBody* getBodyAt(size_t i) const { return i == 0 ? a_.get() : b_.get(); }
   const RigidBodyRef& getBodyRef(size_t i) const { return i == 0 ? a_ : b_; }
   const std::string& getName() const { return name_; }
+  /// The class name given at construction ("BallJoint", "Hinge", "TwoBodyTireModel", ...).
+  const char* getTypeName() const { return typeName_; }
   void setName(const std::string& n) { name_ = n; }
 
   void setEnable(bool e) { enabled_ = e; }

@@ -43,7 +43,12 @@ struct StepReport {
   std::vector<std::string> messages;
   /// Ids of particles whose state became non-finite (they kept their last position and were stopped).
   std::vector<size_t> nonFiniteParticles;
-  bool ok() const { return nonFiniteBodies.empty() && nonFiniteParticles.empty(); }
+  /// Constraints with a DOF whose position error beyond its elastic stretch (ConstraintRow::drift) exceeded
+  /// Solver::getConstraintErrorThreshold() at the start of this step: a joint that came apart (a diverging PGS
+  /// chain stays finite while it separates by metres). Each is logged once, as an error, with its error and
+  /// solve type; it is listed here every step it stays apart.
+  std::vector<const Constraint*> separatedConstraints;
+  bool ok() const { return nonFiniteBodies.empty() && nonFiniteParticles.empty() && separatedConstraints.empty(); }
 };
 
 class Simulation {
@@ -116,6 +121,7 @@ class Simulation {
   void storeContactResults();
   void checkFinite();
   void projectPositions();
+  void reportSeparated(const Constraint& c, Real drift);
   bool computeGeometricStiffness();
   int solverIndex(const RigidBody* b) const;
 

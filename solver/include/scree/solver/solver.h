@@ -98,6 +98,11 @@ class Solver {
   /// Drift the projection tolerates, m (linear rows) or rad (angular rows), > 0. Default 2e-3.
   void setPositionProjectionTolerance(Real tol);
   Real getPositionProjectionTolerance() const { return projectionTolerance_; }
+  /// Position error beyond the elastic stretch (m or rad) above which a joint DOF counts as separated: the
+  /// constraint is listed in StepReport::separatedConstraints and logged once. > 0, +infinity switches the
+  /// check off. Default 0.1.
+  void setConstraintErrorThreshold(Real e);
+  Real getConstraintErrorThreshold() const { return constraintErrorThreshold_; }
   const SolverStats& getStats() const { return stats_; }
   SolverStats& stats() { return stats_; }
 
@@ -115,6 +120,7 @@ class Solver {
   bool projection_ = true;
   int projectionIterations_ = 3;
   Real projectionTolerance_ = 2e-3;
+  Real constraintErrorThreshold_ = 0.1;
   SolverStats stats_;
 };
 
