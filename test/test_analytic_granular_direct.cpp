@@ -24,6 +24,8 @@ struct LumpRun {
   int fallingSteps = 0;   // steps before the first particle-geometry contact
   bool fallingOk = true;  // every falling step: one factorisation, no pivot, all particle rows direct
   size_t fallingRows = 0; // numDirectRows of the falling steps
+  int fallbacks = 0;      // steps whose direct solve hit the pivot or friction-pass cap (finished by PGS)
+  size_t maxPivots = 0;   // most pivots in one step (the landing: unilateral ground normals)
 };
 
 // A tetrahedron of four touching particles (r = 0.05 m, the rigid-sphere version's geometry in
@@ -62,6 +64,8 @@ LumpRun runLump(FrictionModel::SolveType type) {
   for (int i = 0; i < 121; ++i) {
     w.sim->stepForward();
     run.worstSpread = std::max(run.worstSpread, spread());
+    run.fallbacks += st.directFallback ? 1 : 0;
+    run.maxPivots = std::max(run.maxPivots, st.numPivots);
     if (w.sim->getParticleGeometryContacts().empty() && run.fallingSteps == i) {
       ++run.fallingSteps;
       run.fallingRows = st.numDirectRows;
@@ -87,12 +91,13 @@ TEST_SUITE("granular") {
     const LumpRun direct = runLump(FrictionModel::DIRECT);
     const LumpRun iterative = runLump(FrictionModel::ITERATIVE);
     std::printf("particle lump: worst relative displacement DIRECT %.3e m, ITERATIVE %.3e m; base height %.6f / "
-                "%.6f m; %d falling steps, %zu direct rows each\n",
+                "%.6f m; %d falling steps, %zu direct rows each; most pivots in a step %zu, %d fallbacks\n",
                 direct.worstSpread, iterative.worstSpread, direct.baseHeight, iterative.baseHeight,
-                direct.fallingSteps, direct.fallingRows);
+                direct.fallingSteps, direct.fallingRows, direct.maxPivots, direct.fallbacks);
     CHECK(direct.fallingSteps >= 5);  // 0.1 m of free fall at dt 1/60: ~8 steps before the ground is near
     CHECK(direct.fallingOk);
     CHECK(direct.fallingRows == 6 * 3);
+    CHECK(direct.fallbacks == 0);  // every step solved by the direct solver, the landing included
     CHECK(direct.worstSpread < 1e-6);
     CHECK(direct.baseHeight == doctest::Approx(0.05).epsilon(1e-3));  // landed
     // Contrast: the same lump through the particle stage's Gauss-Seidel deforms measurably more (a test that
