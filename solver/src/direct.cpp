@@ -45,6 +45,7 @@ struct DirectSolver::Impl {
   std::vector<Vec3> vf, wf, vc, wc;
   std::vector<Mat3> inertia;
   std::vector<Real> lam, lamOld, lo, hi, eReg, ad, w, b, scratch;
+  std::vector<Real> rhs;  // row rhs minus the row velocity of its kinematic (non-dynamic) sides, which stays fixed
   std::vector<int8_t> state;
   std::vector<int32_t> normalLocal;
   std::vector<int> p, i, diagPos;
@@ -91,11 +92,18 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
   m.side[0].resize(n);
   m.side[1].resize(n);
   m.numSides.assign(n, 0);
+  m.rhs.resize(n);
   for (int k = 0; k < n; ++k) {
     const ConstraintRow& r = rows[set[k]];
+    m.rhs[k] = r.rhs;
     for (int s = 0; s < 2; ++s) {
       const int32_t bi = s == 0 ? r.bodyA : r.bodyB;
-      if (bi < 0 || !(bodies[bi].invMass > 0)) continue;
+      if (bi < 0) continue;
+      if (!(bodies[bi].invMass > 0)) {
+        // Kinematic body (static: zero velocity): not an unknown, but its velocity is part of J v.
+        m.rhs[k] -= (s == 0 ? r.jLinA : r.jLinB).dot(bodies[bi].v) + (s == 0 ? r.jAngA : r.jAngB).dot(bodies[bi].w);
+        continue;
+      }
       if (m.bodyLocal[bi] < 0) {
         m.bodyLocal[bi] = int32_t(m.bodyGlobal.size());
         m.bodyGlobal.push_back(bi);
@@ -327,8 +335,7 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
   auto computeW = [&] {
     velocities(false);
     for (int k = 0; k < n; ++k) {
-      const ConstraintRow& r = rows[set[k]];
-      m.w[k] = rowVel(k) + m.eReg[k] * m.lam[k] - r.rhs;
+      m.w[k] = rowVel(k) + m.eReg[k] * m.lam[k] - m.rhs[k];
     }
   };
 
@@ -344,7 +351,7 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
         for (int q = m.p[j]; q < m.p[j + 1]; ++q)
           if (q != m.diagPos[j] && (m.state[j] != 0 || m.state[m.i[q]] != 0)) Ax[q] = 0;
       for (int k = 0; k < n; ++k)
-        Bx[k] = m.state[k] != 0 ? m.ad[k] * m.lam[k] : rows[set[k]].rhs - rowVel(k);
+        Bx[k] = m.state[k] != 0 ? m.ad[k] * m.lam[k] : m.rhs[k] - rowVel(k);
     } else {
       for (int k = 0; k < n; ++k)
         if (m.state[k] != 0)
@@ -358,7 +365,7 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
         }
       }
       for (int k = 0; k < n; ++k)
-        Bx[rowBase + k] = m.state[k] != 0 ? -m.eReg[k] * m.lam[k] : -rows[set[k]].rhs;
+        Bx[rowBase + k] = m.state[k] != 0 ? -m.eReg[k] * m.lam[k] : -m.rhs[k];
     }
     m.cm.supernodal = kkt ? CHOLMOD_SIMPLICIAL : CHOLMOD_AUTO;
     m.cm.final_ll = kkt ? 0 : 1;

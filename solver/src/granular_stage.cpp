@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "scree/collide/shapes.h"
+#include "scree/solver/direct.h"
 #include "scree/solver/spook.h"
 
 namespace scree::detail {
@@ -33,9 +34,13 @@ struct PairParams {
   Real eN = 0, a = 0, upsilon = 1;  // SPOOK normal row
   Real eT = 0;                      // friction-row regularisation
   Real mu = 0, rest = 0, rolling = 0, adhF = 0, adhO = 0;
+  uint8_t solveType = FrictionModel::ITERATIVE;  // ITERATIVE, or DIRECT mode (see granular_stage.h)
 };
-PairParams makeParams(const SurfaceParameters& s, Real h) {
+PairParams makeParams(const SurfaceParameters& s, const FrictionModel* fm, Real h) {
   PairParams p;
+  // Without SuiteSparse every unit stays iterative (Simulation logs the one-time warning for rigid rows).
+  if (fm && fm->getSolveType() != FrictionModel::ITERATIVE && DirectSolver::available())
+    p.solveType = uint8_t(fm->getSolveType());
   const SpookCoefficients co = spookHolonomic(h, 1.0 / s.getYoungsModulus(), s.getDamping());
   p.eN = co.e;
   p.a = co.a;
@@ -93,8 +98,9 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
   for (size_t i = 0; i < K; ++i)
     for (size_t j = 0; j < K; ++j) {
       SurfaceParameters s;
-      materials.resolve(matTable[i].get(), matTable[j].get(), s, nullptr);
-      ppParams[i * K + j] = makeParams(s, h);
+      const FrictionModel* fm = nullptr;
+      materials.resolve(matTable[i].get(), matTable[j].get(), s, &fm);
+      ppParams[i * K + j] = makeParams(s, fm, h);
     }
   // Particle-geometry: (particle material, geometry material) pairs met this step, plus body indices.
   std::vector<std::pair<std::pair<uint32_t, const Material*>, PairParams>> pgParams;
@@ -114,8 +120,9 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
       while (e < pgParams.size() && pgParams[e].first != key) ++e;
       if (e == pgParams.size()) {
         SurfaceParameters s;
-        materials.resolve(matTable[key.first].get(), gm, s, nullptr);
-        pgParams.push_back({key, makeParams(s, h)});
+        const FrictionModel* fm = nullptr;
+        materials.resolve(matTable[key.first].get(), gm, s, &fm);
+        pgParams.push_back({key, makeParams(s, fm, h)});
       }
       pgParam[k] = uint32_t(e);
       if (c.geometry != lastGeom) {
@@ -229,6 +236,7 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
     const Real vn0 = u.n.dot(vrel);
     const Real vnFree = vn0 + (isPP ? 0.0 : h * gravity.dot(u.n));
     normalRow(u, p, c.depth, vn0, vnFree, ce ? ce->impact : 0.0);
+    u.solveType = p.solveType;
     u.kN = 1.0 / (kn + u.eN);
     u.mu = p.mu;
     u.eT = p.eT;
@@ -279,18 +287,19 @@ void GranularStage::partition(const GranularBodySystem& ps) {
     return std::clamp(int(std::floor((x[i][axis] - lo[axis]) / width)), 0, numSlabs - 1);
   };
   slabOf_.resize(nu);
-  std::vector<uint32_t> count(size_t(numSlabs) + 1, 0);
+  std::vector<uint32_t> count(size_t(numSlabs) + 2, 0);
   for (size_t k = 0; k < nu; ++k) {
     const Unit& u = scratchUnits_[k];
     int sl;
-    if (u.body >= 0) sl = numSlabs;  // touches a dynamic rigid body: serial
+    if (u.solveType != FrictionModel::ITERATIVE) sl = numSlabs + 1;  // DIRECT mode: solved with the rigid rows
+    else if (u.body >= 0) sl = numSlabs;  // touches a dynamic rigid body: serial
     else if (u.b >= 0) sl = std::min(slabOfParticle(u.a), slabOfParticle(size_t(u.b)));
     else sl = slabOfParticle(u.a);
     slabOf_[k] = uint16_t(sl);
     ++count[size_t(sl)];
   }
-  slabStart_.assign(size_t(numSlabs) + 2, 0);
-  for (int sl = 0; sl <= numSlabs; ++sl) slabStart_[size_t(sl) + 1] = slabStart_[size_t(sl)] + count[size_t(sl)];
+  slabStart_.assign(size_t(numSlabs) + 3, 0);
+  for (int sl = 0; sl <= numSlabs + 1; ++sl) slabStart_[size_t(sl) + 1] = slabStart_[size_t(sl)] + count[size_t(sl)];
   std::vector<uint32_t> cursor(slabStart_.begin(), slabStart_.end() - 1);
   units_.resize(nu);
   for (size_t k = 0; k < nu; ++k) units_[cursor[slabOf_[k]]++] = scratchUnits_[k];
@@ -479,7 +488,7 @@ void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyStat
   const auto& x = ps.positions();
   const auto& r = ps.radii();
   shockOrder_.clear();
-  for (uint32_t k = 0; k < units_.size(); ++k) {
+  for (uint32_t k = 0; k < iterativeEnd(); ++k) {
     const Unit& u = units_[k];
     if (u.kN == 0) continue;  // inert (destroyed particle)
     if (u.b < 0) {
@@ -498,6 +507,128 @@ void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyStat
   auto& w = ps.angularVelocities();
   for (int s = 0; s < sweeps; ++s)
     for (const auto& [h, code] : shockOrder_) solveUnitFrozen(units_[code >> 1], int(code & 1), v, w, ps.invMasses(), invInertia_, bodies);
+}
+
+void GranularStage::appendDirectRows(const GranularBodySystem& ps, std::vector<ConstraintRow>& rows,
+                                     std::vector<SolverBodyState>& bodies) {
+  const auto& v = ps.velocities();
+  const auto& w = ps.angularVelocities();
+  const auto& invM = ps.invMasses();
+  const uint32_t begin = iterativeEnd(), end = uint32_t(units_.size());
+  rowBase_ = rows.size();
+  bodyBase_ = bodies.size();
+  extBody_.assign(ps.size(), -1);
+  extParticle_.clear();
+  directRow_.clear();
+  auto bodyOf = [&](size_t i) {
+    if (extBody_[i] < 0) {
+      extBody_[i] = int32_t(bodies.size());
+      extParticle_.push_back(uint32_t(i));
+      SolverBodyState b;
+      b.v = v[i];
+      b.w = w[i];
+      b.invMass = invM[i];
+      b.invInertia = invInertia_[i] * Mat3::Identity();
+      bodies.push_back(b);
+    }
+    return extBody_[i];
+  };
+  for (uint32_t k = begin; k < end; ++k) {
+    const Unit& u = units_[k];
+    const int32_t ia = bodyOf(u.a);
+    const int32_t ib = u.b >= 0 ? bodyOf(size_t(u.b)) : u.body;
+    const auto type = FrictionModel::SolveType(u.solveType);
+    const int32_t normal = int32_t(rows.size());
+    directRow_.push_back(uint32_t(normal));
+    // Same rows as solveUnit: impulse P along +d on a, -d on b (or the body); J v = relative velocity along d.
+    auto linear = [&](const Vec3& d) {
+      ConstraintRow r;
+      r.bodyA = ia;
+      r.bodyB = ib;
+      r.jLinA = d;
+      r.jAngA = u.ra.cross(d);
+      r.jLinB = -d;
+      r.jAngB = -u.rb.cross(d);
+      r.solveType = type;
+      return r;
+    };
+    ConstraintRow rn = linear(u.n);
+    rn.rhs = u.rhsN;
+    rn.e = u.eN;
+    rn.lo = u.loN;  // -1e300 with infinite adhesion: an equality row
+    rn.hi = 1e300;
+    rows.push_back(rn);
+    if (u.mu > 0) {
+      for (int j = 0; j < 2; ++j) {
+        ConstraintRow f = linear(j == 0 ? u.t1 : u.t2);
+        f.e = u.eT;
+        f.mu = u.mu;  // infinite: unbounded
+        f.normalRow = normal;
+        f.friction = true;
+        if (j == 0) f.pairedRow = int32_t(rows.size()) + 1;
+        rows.push_back(f);
+      }
+    }
+    if (u.rollMu > 0 && u.kR > 0) {
+      for (int j = 0; j < 2; ++j) {
+        ConstraintRow f;
+        f.bodyA = ia;
+        f.bodyB = ib;
+        f.jAngA = j == 0 ? u.t1 : u.t2;
+        f.jAngB = -f.jAngA;
+        f.e = u.eT;
+        f.mu = u.rollMu;
+        f.normalRow = normal;
+        f.friction = true;
+        f.solveType = type;
+        if (j == 0) f.pairedRow = int32_t(rows.size()) + 1;
+        rows.push_back(f);
+      }
+    }
+  }
+}
+
+void GranularStage::loadDirectImpulses(std::vector<ConstraintRow>& rows) const {
+  const uint32_t begin = iterativeEnd();
+  for (size_t j = 0; j < directRow_.size(); ++j) {
+    const Unit& u = units_[begin + j];
+    size_t r = directRow_[j];
+    rows[r++].lambda = u.lN;
+    if (u.mu > 0) {
+      rows[r++].lambda = u.lT1;
+      rows[r++].lambda = u.lT2;
+    }
+    if (u.rollMu > 0 && u.kR > 0) {
+      rows[r++].lambda = u.lR1;
+      rows[r++].lambda = u.lR2;
+    }
+  }
+}
+
+void GranularStage::finishDirect(GranularBodySystem& ps, std::vector<ConstraintRow>& rows,
+                                 std::vector<SolverBodyState>& bodies) {
+  const uint32_t begin = iterativeEnd();
+  for (size_t j = 0; j < directRow_.size(); ++j) {
+    Unit& u = units_[begin + j];
+    size_t r = directRow_[j];
+    u.lN = rows[r++].lambda;
+    if (u.mu > 0) {
+      u.lT1 = rows[r++].lambda;
+      u.lT2 = rows[r++].lambda;
+    }
+    if (u.rollMu > 0 && u.kR > 0) {
+      u.lR1 = rows[r++].lambda;
+      u.lR2 = rows[r++].lambda;
+    }
+  }
+  auto& v = ps.velocities();
+  auto& w = ps.angularVelocities();
+  for (size_t k = 0; k < extParticle_.size(); ++k) {
+    v[extParticle_[k]] = bodies[bodyBase_ + k].v;
+    w[extParticle_[k]] = bodies[bodyBase_ + k].w;
+  }
+  rows.resize(rowBase_);
+  bodies.resize(bodyBase_);
 }
 
 void GranularStage::integrate(GranularBodySystem& ps, Real h, std::vector<size_t>& outNonFinite,

@@ -24,6 +24,24 @@
 //   integrate  x += h v for live particles; a particle whose velocity or position turns non-finite is
 //              reported by id, keeps its last position and is stopped.
 //   store      forces into the contact lists, impulses into the warm-start cache.
+//
+// DIRECT mode (AGX manual: particle solve type agx::FrictionModel::DIRECT, with infinite friction and adhesion
+// and zero adhesive overlap a stiff, glued lump): a unit whose resolved contact material's solve type is not
+// ITERATIVE (DIRECT, SPLIT or DIRECT_AND_ITERATIVE; needs SuiteSparse, else every unit stays iterative) is
+// put in its own range after the serial set by partition, and the sweeps and the shock pass skip it. In
+// Simulation::solve, after prepare (warm start), appendDirectRows appends one SolverBodyState per particle of
+// such units after the rigid bodies and the units' rows as ConstraintRows: the normal row with the unit's SPOOK
+// rhs, e and lower bound (infinite adhesion: unbounded), two friction rows scaled by the normal row
+// (normalRow / mu; infinite mu: unbounded) and the two rolling rows if any. They carry the material's solve
+// type and the friction flag, so they are classified exactly like rigid contact rows: DIRECT units entirely in
+// the direct set; SPLIT and DIRECT_AND_ITERATIVE units with the normal direct and friction/rolling swept by
+// the rigid PgsSolver in the hybrid rounds. The rigid and particle direct rows are solved by one DirectSolver
+// call (a lump resting on DIRECT rigid rows couples); a lump whose rows are all equalities is one
+// factorisation and no pivot. finishDirect copies the impulses back into the units (warm start, storeResults
+// and contact forces unchanged) and the velocities into the particle arrays, and removes the appended rows and
+// bodies. Then the iterative units are swept as before, with the direct impulses held. With iterative rigid
+// rows present the hybrid alternation applies (Solver::setNumHybridRounds direct solves per step). Without
+// DIRECT-mode units nothing of this runs: the cost is one comparison per unit in partition.
 #pragma once
 
 #include <cstdint>
@@ -33,6 +51,7 @@
 #include "scree/collide/particle_collider.h"
 #include "scree/core/granular_body_system.h"
 #include "scree/core/material.h"
+#include "scree/solver/constraint_row.h"
 #include "scree/solver/pgs.h"
 #include "scree/solver/solver.h"
 
@@ -61,8 +80,24 @@ class GranularStage {
   /// instead of being propagated by a few Gauss-Seidel sweeps. Serial (deterministic). `sweeps` passes.
   void shockPass(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies, const Vec3& up, int sweeps);
   /// True when some particle touches a dynamic rigid body (then Simulation interleaves the rigid sweeps).
-  bool coupled() const { return !slabStart_.empty() && slabStart_.back() > slabStart_[size_t(numSlabs_)]; }
+  bool coupled() const { return !slabStart_.empty() && iterativeEnd() > slabStart_[size_t(numSlabs_)]; }
   bool hasUnits() const { return !units_.empty(); }
+
+  // ---- DIRECT mode (see the header comment) -------------------------------------------------------------------
+  /// Units whose contact material's solve type is not ITERATIVE (always 0 without SuiteSparse).
+  size_t numDirectUnits() const { return units_.empty() ? 0 : units_.size() - iterativeEnd(); }
+  bool hasDirectUnits() const { return numDirectUnits() > 0; }
+  bool hasIterativeUnits() const { return !units_.empty() && iterativeEnd() > 0; }
+  /// Appends one solver body per particle of a DIRECT-mode unit to `bodies` (velocities copied from the particle
+  /// arrays, which must already hold the warm start: call prepare() first) and the units' rows to `rows`, with
+  /// lambda = 0 so that PgsSolver::prepare does not apply the warm start a second time.
+  void appendDirectRows(const GranularBodySystem& ps, std::vector<ConstraintRow>& rows,
+                        std::vector<SolverBodyState>& bodies);
+  /// After PgsSolver::prepare: the appended rows take the units' warm-start impulses (already in the velocities).
+  void loadDirectImpulses(std::vector<ConstraintRow>& rows) const;
+  /// After the solve: impulses back into the units, velocities back into the particle arrays, and the appended
+  /// rows and bodies removed again.
+  void finishDirect(GranularBodySystem& ps, std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies);
   /// Positions; non-finite particles are appended to outNonFinite (ids) with a message each.
   void integrate(GranularBodySystem& ps, Real h, std::vector<size_t>& outNonFinite, std::vector<std::string>& outMessages,
                  Real time);
@@ -87,7 +122,10 @@ class GranularStage {
     Real lN = 0, lT1 = 0, lT2 = 0, lR1 = 0, lR2 = 0;
     Real impact = 0;      // approach speed of a speculative stop this step, remembered for next step's bounce
     bool flip = false;    // a's slot is the higher one of the pair (warm-start vectors are stored for the lower)
+    uint8_t solveType = FrictionModel::ITERATIVE;  // of the contact material; not ITERATIVE: DIRECT mode
   };
+  /// End of the units the particle sweeps and the shock pass visit; the DIRECT-mode units follow.
+  uint32_t iterativeEnd() const { return slabStart_[size_t(numSlabs_) + 1]; }
   struct CacheEntry {
     uint64_t key;
     uint32_t feature;
@@ -107,13 +145,19 @@ class GranularStage {
   ParticleCollider collider_;
   uint64_t stepCount_ = 0;
   std::vector<Unit> units_;          // all units, the parallel ones grouped by colour first
-  std::vector<uint32_t> slabStart_;  // [numSlabs + 2] ranges into units_; the last range is the serial set
+  // [numSlabs + 3] ranges into units_: numSlabs slabs, the serial set, the DIRECT-mode units.
+  std::vector<uint32_t> slabStart_;
   int numSlabs_ = 1;
   std::vector<Real> invInertia_;     // [size()] 1 / (0.4 m r^2)
   std::vector<Unit> scratchUnits_;
   std::vector<uint16_t> slabOf_;
   std::vector<std::pair<Real, uint32_t>> shockOrder_;  // (height of the lower side, unit * 2 + frozen side)
   std::vector<CacheEntry> ppCache_, pgCache_, nextPp_, nextPg_;
+  // DIRECT mode, valid between appendDirectRows and finishDirect.
+  size_t rowBase_ = 0, bodyBase_ = 0;  // sizes of rows / bodies before the append
+  std::vector<int32_t> extBody_;       // [size()] solver body of a particle, -1 none
+  std::vector<uint32_t> extParticle_;  // particle of each appended body
+  std::vector<uint32_t> directRow_;    // first row of each DIRECT-mode unit (normal, [2 friction], [2 rolling])
 };
 
 }  // namespace scree::detail

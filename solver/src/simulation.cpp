@@ -695,8 +695,16 @@ void Simulation::solve() {
     st.lastResidual = 0;
     return;
   }
+  // Particle contacts whose contact material is not ITERATIVE (the manual's DIRECT particle mode,
+  // granular_stage.h) become rows on solver bodies appended to m.sb, so they are classified, solved (one
+  // DirectSolver call with the rigid direct set) and counted like rigid rows; finishDirect removes them again.
+  const bool particleDirect = particles && m.granular.hasDirectUnits();
+  if (particleDirect) {
+    m.granular.prepare(granular_, m.sb);  // warm start first: the appended bodies copy these velocities
+    m.granular.appendDirectRows(granular_, m.rows, m.sb);
+  }
   // Direct set (DESIGN.md §2 step 7): DIRECT rows; SPLIT and DIRECT_AND_ITERATIVE rows except friction. PGS
-  // sweeps the rest, and DIRECT_AND_ITERATIVE rows too (after their direct solve). Particle contacts are always
+  // sweeps the rest, and DIRECT_AND_ITERATIVE rows too (after their direct solve). Other particle contacts are
   // solved by the particle stage's parallel Gauss–Seidel.
   m.directSet.clear();
   m.iterSet.clear();
@@ -715,12 +723,14 @@ void Simulation::solve() {
   if (!m.directSet.empty()) addGeometricStiffness();
   const int iterations = solver_.getNumIterations();
   if (!m.rows.empty()) PgsSolver::prepare(m.rows, m.sb);
-  if (particles) m.granular.prepare(granular_, m.sb);
+  if (particleDirect) m.granular.loadDirectImpulses(m.rows);
+  else if (particles) m.granular.prepare(granular_, m.sb);
   if (!m.directSet.empty()) {
     // Rigid rows through the hybrid direct/iterative solve, then the particles against its result.
     solveHybrid(split);
+    if (particleDirect) m.granular.finishDirect(granular_, m.rows, m.sb);
     Real residual = st.lastResidual;
-    if (particles) {
+    if (particles && m.granular.hasIterativeUnits()) {
       for (int it = 0; it < iterations; ++it)
         residual = std::max(residual, m.granular.sweep(granular_, m.sb, it % 2 == 1));
       if (solver_.getUseShockPropagation() && gravity_.squaredNorm() > 0)

@@ -4,6 +4,7 @@
 // The rows of the direct set D are solved together with every other row's impulse held fixed (their effect is
 // already in the body velocities). With v_f the velocities without D's impulses, the system is the mixed LCP
 //   A lambda = b,  A = G M^-1 G^T + E,  b = rhs - G v_f,   lo <= lambda <= hi  (complementary to w = A lambda - b)
+// Kinematic bodies (invMass 0, prescribed velocity) are not unknowns: their part of G v is moved into b.
 // solved in one of two forms:
 //   SCHUR  A itself (symmetric positive definite since E > 0): CHOLMOD LL^T.
 //   KKT    [M  -G^T; -G  -E] [v+; lambda] = [M v_f; -rhs], quasi-definite (M > 0, E > 0): CHOLMOD simplicial

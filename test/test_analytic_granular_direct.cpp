@@ -1,0 +1,226 @@
+// Particles (GranularBodySystem) through the DIRECT solver (the manual's DIRECT particle mode, see
+// solver/src/granular_stage.h): a glued lump that must stay rigid while falling and landing (one factorisation,
+// no pivot per falling step), against the same lump solved iteratively, and a particle column whose overlaps
+// must be the compliance-predicted load / stiffness of each contact.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include <scree/scree.h>
+
+#include "test_world.h"
+
+using namespace scree;
+
+namespace {
+
+struct LumpRun {
+  Real worstSpread = 0;   // max over the run and over all pairs of ||x_i - x_j| - d|, m
+  Real baseHeight = 0;    // mean height of the three base particles at the end, m
+  int fallingSteps = 0;   // steps before the first particle-geometry contact
+  bool fallingOk = true;  // every falling step: one factorisation, no pivot, all particle rows direct
+  size_t fallingRows = 0; // numDirectRows of the falling steps
+  int fallbacks = 0;      // steps whose direct solve hit the pivot or friction-pass cap (finished by PGS)
+  size_t maxPivots = 0;   // most pivots in one step (the landing: unilateral ground normals)
+};
+
+// A tetrahedron of four touching particles (r = 0.05 m, the rigid-sphere version's geometry in
+// test_analytic_direct.cpp), base 0.1 m above the ground, glued: particle-particle friction and adhesion
+// infinite, adhesive overlap 0, restitution 0; particle-ground restitution 0. Both contact materials get
+// `type`.
+LumpRun runLump(FrictionModel::SolveType type) {
+  test::TestWorld w;
+  w.addGround();
+  auto glue = std::make_shared<Material>("glue");
+  auto cm = w.sim->getMaterialManager().getOrCreateContactMaterial(glue, glue);
+  cm->setFrictionCoefficient(std::numeric_limits<Real>::infinity());
+  cm->setAdhesion(std::numeric_limits<Real>::infinity(), 0.0);
+  cm->setRestitution(0.0);
+  cm->setSolveType(type);
+  auto cg = w.sim->getMaterialManager().getOrCreateContactMaterial(glue, w.material);
+  cg->setRestitution(0.0);
+  cg->setSolveType(type);
+  auto& ps = w.sim->getGranularBodySystem();
+  ps.setMaterial(glue);
+  const Real r = 0.05, d = 2 * r;
+  const Vec3 base(0, 0, r + 0.1);
+  const Vec3 pos[4] = {base, base + Vec3(d, 0, 0), base + Vec3(d / 2, d * std::sqrt(3.0) / 2, 0),
+                       base + Vec3(d / 2, d * std::sqrt(3.0) / 6, d * std::sqrt(2.0 / 3.0))};
+  std::vector<size_t> ids;
+  for (const Vec3& p : pos) ids.push_back(ps.createParticle(p, r));
+  auto spread = [&] {
+    Real worst = 0;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j)
+        worst = std::max(worst, std::abs((ps.getPosition(ids[i]) - ps.getPosition(ids[j])).norm() - d));
+    return worst;
+  };
+  LumpRun run;
+  const auto& st = w.sim->getSolver().getStats();
+  for (int i = 0; i < 121; ++i) {
+    w.sim->stepForward();
+    run.worstSpread = std::max(run.worstSpread, spread());
+    run.fallbacks += st.directFallback ? 1 : 0;
+    run.maxPivots = std::max(run.maxPivots, st.numPivots);
+    if (w.sim->getParticleGeometryContacts().empty() && run.fallingSteps == i) {
+      ++run.fallingSteps;
+      run.fallingRows = st.numDirectRows;
+      run.fallingOk &= st.numFactorisations == 1 && st.numPivots == 0 && st.numDirectRows == 6 * 3;
+    }
+  }
+  for (int i = 0; i < 3; ++i) run.baseHeight += ps.getPosition(ids[size_t(i)]).z() / 3;
+  return run;
+}
+
+}  // namespace
+
+TEST_SUITE("granular") {
+  TEST_CASE("a lump of particles with infinite friction and adhesion falls and lands as one body") {
+    // The manual's DIRECT particle mode: friction and adhesion infinite, adhesive overlap zero, so among the
+    // lump's particles every row is an equality (no bound): while the lump falls each step is one
+    // factorisation and no pivot, and all 6 pairs x (normal + 2 friction) rows are in the direct set.
+    //
+    // Bound on the relative displacement: the glue rows are springs of stiffness E (glue-glue: 4e8 in series
+    // with 4e8 = 2e8 N/m per point). Landing at v = sqrt(2 g 0.1) = 1.4 m/s with restitution 0 stops the lump
+    // within a step, which loads a glue contact with at most m v / h = 0.52 * 1.4 * 60 = 44 N, i.e.
+    // 44 / 2e8 = 2.2e-7 m; at rest the top particle's weight, 5 N, gives 2.6e-8 m. 1e-6 m leaves a factor 4.
+    const LumpRun direct = runLump(FrictionModel::DIRECT);
+    const LumpRun iterative = runLump(FrictionModel::ITERATIVE);
+    std::printf("particle lump: worst relative displacement DIRECT %.3e m, ITERATIVE %.3e m; base height %.6f / "
+                "%.6f m; %d falling steps, %zu direct rows each; most pivots in a step %zu, %d fallbacks\n",
+                direct.worstSpread, iterative.worstSpread, direct.baseHeight, iterative.baseHeight,
+                direct.fallingSteps, direct.fallingRows, direct.maxPivots, direct.fallbacks);
+    CHECK(direct.fallingSteps >= 5);  // 0.1 m of free fall at dt 1/60: ~8 steps before the ground is near
+    CHECK(direct.fallingOk);
+    CHECK(direct.fallingRows == 6 * 3);
+    CHECK(direct.fallbacks == 0);  // every step solved by the direct solver, the landing included
+    CHECK(direct.worstSpread < 1e-6);
+    CHECK(direct.baseHeight == doctest::Approx(0.05).epsilon(1e-3));  // landed
+    // Contrast: the same lump through the particle stage's Gauss-Seidel deforms measurably more (a test that
+    // could not fail would not show that the DIRECT path is taken).
+    CHECK(iterative.fallingRows == 0);
+    CHECK(iterative.worstSpread > 10 * direct.worstSpread);
+  }
+
+  TEST_CASE("a DIRECT particle column settles at the compliance-predicted overlaps") {
+    for (FrictionModel::SolveType type :
+         {FrictionModel::DIRECT, FrictionModel::SPLIT, FrictionModel::DIRECT_AND_ITERATIVE}) {
+      CAPTURE(type);
+      // Three particles stacked on the ground, finite friction, every contact's normal in the direct solver
+      // (DIRECT: friction too; SPLIT, DIRECT_AND_ITERATIVE: friction by PGS). The granular stage maps
+      // the contact's Young's modulus E to the SPOOK compliance eps = 1 / E (N/m per contact point,
+      // granular_stage.cpp makeParams -> spookHolonomic), and at rest a SPOOK row gives lambda / h = g / eps: each
+      // contact's overlap is its load over E. Loads from the top: m g, 2 m g (particle-particle, E_pp) and
+      // 3 m g (ground, E_pg). The direct solve is exact (no iteration residual) and the damping time 0.075 s
+      // decays the start-up transient over 3 s (40 damping times) far below 1 %.
+      test::TestWorld w(1.0 / 100.0, 9.81, 0.5, 0.0);
+      w.addGround();
+      const Real r = 0.05, Epp = 1e5, Epg = 2e5, g = 9.81;
+      auto mat = std::make_shared<Material>("p");
+      auto cpp = w.sim->getMaterialManager().getOrCreateContactMaterial(mat, mat);
+      cpp->setYoungsModulus(Epp);
+      cpp->setFrictionCoefficient(0.5);
+      cpp->setRestitution(0.0);
+      cpp->setSolveType(type);
+      auto cpg = w.sim->getMaterialManager().getOrCreateContactMaterial(mat, w.material);
+      cpg->setYoungsModulus(Epg);
+      cpg->setFrictionCoefficient(0.5);
+      cpg->setRestitution(0.0);
+      cpg->setSolveType(type);
+      auto& ps = w.sim->getGranularBodySystem();
+      ps.setMaterial(mat);
+      std::vector<size_t> ids;
+      for (int i = 0; i < 3; ++i) ids.push_back(ps.createParticle(Vec3(0, 0, r + 2 * r * i), r));
+      w.stepSeconds(3.0);
+      const Real m = ps.getMass(ids[0]);
+      const Real z0 = ps.getPosition(ids[0]).z(), z1 = ps.getPosition(ids[1]).z(), z2 = ps.getPosition(ids[2]).z();
+      const Real ground = r - z0, lower = 2 * r - (z1 - z0), upper = 2 * r - (z2 - z1);
+      std::printf("particle column: overlaps %.6e %.6e %.6e m, predicted %.6e %.6e %.6e m\n", ground, lower, upper,
+                  3 * m * g / Epg, 2 * m * g / Epp, m * g / Epp);
+      CHECK(ground == doctest::Approx(3 * m * g / Epg).epsilon(0.01));
+      CHECK(lower == doctest::Approx(2 * m * g / Epp).epsilon(0.01));
+      CHECK(upper == doctest::Approx(m * g / Epp).epsilon(0.01));
+      const auto& st = w.sim->getSolver().getStats();
+      // Three contacts, normal + 2 friction rows each; SPLIT and DIRECT_AND_ITERATIVE leave the friction rows to
+      // PGS (like rigid contact rows), DIRECT_AND_ITERATIVE sweeps the normals too.
+      CHECK(st.numDirectRows == (type == FrictionModel::DIRECT ? 9u : 3u));
+      CHECK(st.numIterativeRows == (type == FrictionModel::DIRECT ? 0u : type == FrictionModel::SPLIT ? 6u : 9u));
+      CHECK(st.numFactorisations >= 1);
+      CHECK(st.numPivots == 0);  // at rest the active set is last step's
+      CHECK(ps.getVelocity(ids[2]).norm() < 1e-6);
+      // Contact forces come back from the direct solve into the particle contact lists.
+      REQUIRE(w.sim->getParticleGeometryContacts().size() == 1);
+      CHECK(w.sim->getParticleGeometryContacts()[0].normalForce == doctest::Approx(3 * m * g).epsilon(0.01));
+    }
+  }
+
+  TEST_CASE("a DIRECT particle on a DIRECT box is solved in the same direct solve") {
+    // A particle (E_pb) resting on a 1 kg box that rests on the ground (E_bg per point, 4 points): particle and
+    // box rows are one direct system, so the ground carries (M + m) g at once and the particle's overlap is
+    // m g / E_pb (SPOOK at rest, as in the column case). 1 %: the transient after 2 s (27 damping times).
+    test::TestWorld w(1.0 / 100.0, 9.81, 0.5, 0.0);
+    w.addGround();
+    const Real r = 0.05, Epb = 1e5, g = 9.81, M = 1.0;
+    w.contactMaterial->setSolveType(FrictionModel::DIRECT);
+    auto mat = std::make_shared<Material>("p");
+    auto cpb = w.sim->getMaterialManager().getOrCreateContactMaterial(mat, w.material);
+    cpb->setYoungsModulus(Epb);
+    cpb->setRestitution(0.0);
+    cpb->setSolveType(FrictionModel::DIRECT);
+    auto box = w.addBox(Vec3(0.2, 0.2, 0.1), Vec3(0, 0, 0.1), M);
+    auto& ps = w.sim->getGranularBodySystem();
+    ps.setMaterial(mat);
+    const size_t id = ps.createParticle(Vec3(0.03, -0.02, 0.2 + r), r);
+    w.stepSeconds(2.0);
+    const Real m = ps.getMass(id);
+    Real ground = 0;
+    for (const ContactPoint& p : w.contactPoints()) ground += p.normalForce;
+    const Real overlap = box->getPosition().z() + 0.1 + r - ps.getPosition(id).z();
+    std::printf("particle on box: ground force %.6f N (predicted %.6f), overlap %.6e m (predicted %.6e)\n", ground,
+                (M + m) * g, overlap, m * g / Epb);
+    CHECK(ground == doctest::Approx((M + m) * g).epsilon(0.01));
+    CHECK(overlap == doctest::Approx(m * g / Epb).epsilon(0.01));
+    const auto& st = w.sim->getSolver().getStats();
+    CHECK(st.numDirectRows == 4 * 3 + 3);  // box-ground: 4 points x 3 rows; particle-box: 3 rows
+    CHECK(st.numIterativeRows == 0);
+    CHECK(st.numPivots == 0);
+    // One direct solve (no iterative rows: one hybrid round); its friction-bound pass (bounds +-mu lambda_n from
+    // the previous pass's normals) may refactor once.
+    CHECK(st.numFactorisations >= 1);
+    CHECK(st.numFactorisations <= 2);
+  }
+
+  TEST_CASE("a particle and a box ride a rising kinematic platform without sinking, DIRECT as ITERATIVE") {
+    // The platform's prescribed velocity is part of each contact row's J v. The direct solve once left it out
+    // (only dynamic bodies are unknowns there), so with DIRECT contacts the particle and the box sank into a
+    // platform rising at 0.5 m/s until the SPOOK position term balanced it: v / a = 0.5 / 12.9 = 3.9 cm. Now the
+    // overlap is the weight's compliance (m g / E < 1e-6 m here) for both solve types; 1e-5 m allows for the
+    // damping transient.
+    for (FrictionModel::SolveType type : {FrictionModel::ITERATIVE, FrictionModel::DIRECT}) {
+      CAPTURE(type);
+      test::TestWorld w(1.0 / 100.0, 9.81, 0.5, 0.0);
+      w.contactMaterial->setSolveType(type);
+      auto platform = w.addBox(Vec3(1, 1, 0.1), Vec3(0, 0, -0.1), 1.0);
+      platform->setMotionControl(RigidBody::KINEMATICS);
+      platform->setVelocity(Vec3(0, 0, 0.5));
+      auto box = w.addBox(Vec3(0.1, 0.1, 0.1), Vec3(0.3, 0, 0.1), 1.0);
+      auto& ps = w.sim->getGranularBodySystem();
+      ps.setMaterial(w.material);
+      const size_t id = ps.createParticle(Vec3(-0.3, 0, 0.05), 0.05);
+      w.stepSeconds(1.0);
+      const Real top = platform->getPosition().z() + 0.1;
+      CHECK(top == doctest::Approx(0.5).epsilon(1e-9));
+      CHECK(std::abs(top - (box->getPosition().z() - 0.1)) < 1e-5);
+      CHECK(std::abs(top - (ps.getPosition(id).z() - 0.05)) < 1e-5);
+      CHECK(box->getVelocity().z() == doctest::Approx(0.5).epsilon(1e-3));
+      CHECK(ps.getVelocity(id).z() == doctest::Approx(0.5).epsilon(1e-3));
+      if (type == FrictionModel::DIRECT) {
+        CHECK(w.sim->getSolver().getStats().numDirectRows > 3);  // particle and box rows both direct
+      }
+    }
+  }
+}
