@@ -56,12 +56,9 @@ TwoBodyTireModel::TwoBodyTireModel(RigidBodyRef tireBody, Real tireRadius, Rigid
     stiffness_[m] = defaultStiffness;
     dampingCoef_[m] = defaultDamping;
   }
-  // The tire's compliant rows are solved by PGS with the tire's contacts by default: in the hybrid
-  // DIRECT_AND_ITERATIVE split the tire rows (direct) and the contacts that load them (iterative) exchange impulses
-  // only once per hybrid round, which leaves a motor-driven wheel's torsional wind-up several per cent off (and
-  // 13x off with the tire DIRECT and a DIRECT_AND_ITERATIVE hinge motor). All-DIRECT and all-ITERATIVE both meet
-  // the closed forms (test_model_tire_rolling); setSolveType() overrides.
-  setSolveType(FrictionModel::ITERATIVE);
+  // Solve type: the constraint default, DIRECT_AND_ITERATIVE, like every joint (AGX's default). (An earlier
+  // ITERATIVE default here worked around a DirectSolver bug -- a moving kinematic body's velocity was left out of
+  // the direct rows, so a rig on a kinematic carriage got wrong wind-up -- fixed in direct.cpp.)
   listener_ = std::make_shared<TireFrictionListener>(this);
 }
 
