@@ -9,22 +9,10 @@
 #include <scree/scree.h>
 #include <scree/solver/direct.h>
 
-using namespace scree;
+#include "test_badinput.h"
 
-namespace {
-template <class F>
-void expectInvalid(F&& f, const std::string& param, const std::string& value) {
-  try {
-    f();
-    FAIL("no exception for " << param);
-  } catch (const std::invalid_argument& e) {
-    const std::string what = e.what();
-    INFO(what);
-    CHECK(what.find(param) != std::string::npos);
-    CHECK(what.find(value) != std::string::npos);
-  }
-}
-}  // namespace
+using namespace scree;
+using namespace scree::test;
 
 TEST_CASE("Solver: pivot cap and hybrid rounds must be >= 1") {
   Solver s;

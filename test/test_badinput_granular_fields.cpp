@@ -12,30 +12,10 @@
 #include "scree/core/granular_body_system.h"
 #include "scree/model/granular_field_post_processor.h"
 
+#include "test_badinput.h"
+
 using namespace scree;
-
-namespace {
-
-const Real kNaN = std::numeric_limits<Real>::quiet_NaN();
-const Real kInf = std::numeric_limits<Real>::infinity();
-
-template <class F>
-void expectInvalid(F&& f, std::initializer_list<std::string> needles) {
-  bool thrown = false;
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    thrown = true;
-    const std::string what = e.what();
-    for (const std::string& n : needles) {
-      INFO("message: " << what << "  expected to contain: " << n);
-      CHECK(what.find(n) != std::string::npos);
-    }
-  }
-  CHECK(thrown);
-}
-
-}  // namespace
+using namespace scree::test;
 
 TEST_SUITE("badinput.granular_fields") {
 

@@ -14,30 +14,15 @@
 #include "scree/core/errors.h"
 #include "scree/core/rigid_body.h"
 
+#include "test_badinput.h"
+
 using namespace scree;
+using namespace scree::test;
 
 namespace {
 
-const Real kNaN = std::numeric_limits<Real>::quiet_NaN();
-const Real kInf = std::numeric_limits<Real>::infinity();
 const Real kBadScalars[] = {kNaN, kInf, -kInf, -1.0, 0.0};
 
-/// Runs f, expects std::invalid_argument whose message contains every string in `needles`.
-template <class F>
-void expectInvalid(F&& f, std::initializer_list<std::string> needles) {
-  bool thrown = false;
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    thrown = true;
-    const std::string what = e.what();
-    for (const std::string& n : needles) {
-      INFO("message: " << what << "  expected to contain: " << n);
-      CHECK(what.find(n) != std::string::npos);
-    }
-  }
-  CHECK(thrown);
-}
 
 /// How errors.h prints a scalar (inf, -inf, nan, -1, 0).
 std::string fmt(Real v) { return detail::formatValue(v); }

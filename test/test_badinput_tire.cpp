@@ -8,24 +8,13 @@
 
 #include <scree/scree.h>
 
+#include "test_badinput.h"
+
 using namespace scree;
+using namespace scree::test;
 
 namespace {
-const Real kNaN = std::numeric_limits<Real>::quiet_NaN();
-const Real kInf = std::numeric_limits<Real>::infinity();
 
-template <class F>
-void expectInvalid(F&& f, const std::string& param, const std::string& value) {
-  try {
-    f();
-    FAIL("no exception for " << param);
-  } catch (const std::invalid_argument& e) {
-    const std::string what = e.what();
-    INFO(what);
-    CHECK(what.find(param) != std::string::npos);
-    CHECK(what.find(value) != std::string::npos);
-  }
-}
 
 RigidBodyRef body(const std::string& name) {
   auto b = std::make_shared<RigidBody>(name);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "rolling_radius.h"
 #include "scree/collide/shapes.h"
 #include "scree/solver/direct.h"
 #include "scree/solver/spook.h"
@@ -19,13 +20,14 @@ constexpr int kMaxSlabs = 64;
 
 uint64_t slotKey(size_t id) { return uint64_t(uint32_t(id & 0xffffffffu)); }
 
-Real rollingRadiusOf(const Geometry* g) {
-  const Shape* s = g->getShape().get();
-  switch (s->getType()) {
-    case Shape::SPHERE: return static_cast<const Sphere*>(s)->getRadius();
-    case Shape::CYLINDER: return static_cast<const Cylinder*>(s)->getRadius();
-    case Shape::CAPSULE: return static_cast<const Capsule*>(s)->getRadius();
-    default: return 0;
+// Scales the pair (l1, l2) onto the disc of radius lim when it lies outside (projected-cone friction and the
+// rolling-resistance disc).
+inline void projectOntoDisc(Real& l1, Real& l2, Real lim) {
+  const Real mag2 = l1 * l1 + l2 * l2;
+  if (mag2 > lim * lim) {
+    const Real s = lim / std::sqrt(mag2);
+    l1 *= s;
+    l2 *= s;
   }
 }
 
@@ -216,7 +218,7 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
         // (average of the two, the rows are solved as a disc).
         kr += 0.5 * (u.t1.dot(sb.invInertia * u.t1) + u.t2.dot(sb.invInertia * u.t2));
       }
-      const Real gr = rollingRadiusOf(c.geometry);
+      const Real gr = rollingRadius(c.geometry);
       if (gr > 0) rollR = r[a] * gr / (r[a] + gr);
     }
     // Warm start and remembered impact speed.
@@ -368,12 +370,7 @@ void GranularStage::solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& 
     Real l1 = u.lT1 + (-u.t1.dot(vr) - u.eT * u.lT1) * u.kT1;
     Real l2 = u.lT2 + (-u.t2.dot(vr) - u.eT * u.lT2) * u.kT2;
     const Real lim = std::isinf(u.mu) ? 1e300 : u.mu * std::max<Real>(u.lN, 0);
-    const Real mag2 = l1 * l1 + l2 * l2;
-    if (mag2 > lim * lim) {
-      const Real s = lim / std::sqrt(mag2);
-      l1 *= s;
-      l2 *= s;
-    }
+    projectOntoDisc(l1, l2, lim);
     const Real d1 = l1 - u.lT1, d2 = l2 - u.lT2;
     u.lT1 = l1;
     u.lT2 = l2;
@@ -387,12 +384,7 @@ void GranularStage::solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& 
     Real l1 = u.lR1 + (-u.t1.dot(wr) - u.eT * u.lR1) * u.kR;
     Real l2 = u.lR2 + (-u.t2.dot(wr) - u.eT * u.lR2) * u.kR;
     const Real lim = u.rollMu * std::max<Real>(u.lN, 0);
-    const Real mag2 = l1 * l1 + l2 * l2;
-    if (mag2 > lim * lim) {
-      const Real s = lim / std::sqrt(mag2);
-      l1 *= s;
-      l2 *= s;
-    }
+    projectOntoDisc(l1, l2, lim);
     const Vec3 T = (l1 - u.lR1) * u.t1 + (l2 - u.lR2) * u.t2;
     u.lR1 = l1;
     u.lR2 = l2;
@@ -469,12 +461,7 @@ void GranularStage::solveUnitFrozen(Unit& u, int frozen, std::vector<Vec3>& v, s
     Real l1 = u.lT1 + (-u.t1.dot(vr) - u.eT * u.lT1) * kInv(u.t1, u.eT);
     Real l2 = u.lT2 + (-u.t2.dot(vr) - u.eT * u.lT2) * kInv(u.t2, u.eT);
     const Real lim = std::isinf(u.mu) ? 1e300 : u.mu * std::max<Real>(u.lN, 0);
-    const Real mag2 = l1 * l1 + l2 * l2;
-    if (mag2 > lim * lim) {
-      const Real s = lim / std::sqrt(mag2);
-      l1 *= s;
-      l2 *= s;
-    }
+    projectOntoDisc(l1, l2, lim);
     const Real d1 = l1 - u.lT1, d2 = l2 - u.lT2;
     u.lT1 = l1;
     u.lT2 = l2;

@@ -9,6 +9,7 @@
 #include "body_access.h"
 #include "granular_stage.h"
 #include "integrator.h"
+#include "rolling_radius.h"
 #include "scree/collide/narrowphase.h"
 #include "scree/core/errors.h"
 #include "scree/core/logger.h"
@@ -26,16 +27,6 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 
 uint64_t pairKeyOf(const GeometryContact& c) {
   return (uint64_t(c.geometry(0)->getId()) << 32) | c.geometry(1)->getId();
-}
-// Rolling radius of a geometry for rolling resistance: spheres, cylinders and capsules roll; others do not.
-Real rollingRadius(const Geometry* g) {
-  const Shape* s = g->getShape().get();
-  switch (s->getType()) {
-    case Shape::SPHERE: return static_cast<const Sphere*>(s)->getRadius();
-    case Shape::CYLINDER: return static_cast<const Cylinder*>(s)->getRadius();
-    case Shape::CAPSULE: return static_cast<const Capsule*>(s)->getRadius();
-    default: return 0;
-  }
 }
 bool touching(const GeometryContact& c) {
   for (const ContactPoint& p : c.points())
@@ -100,6 +91,7 @@ struct Simulation::Impl {
   std::vector<uint32_t> directSet, iterSet;
   std::vector<Real> geomK;
   bool pureIterative = false;  // some row is only in the iterative set
+  bool nonIterativeRows = false;  // buildRows made a row whose solve type is not ITERATIVE
   // Post-step position projection (projectPositions): its own direct solver, so each keeps its cached analysis.
   DirectSolver projector;
   std::vector<ConstraintRow> projRows;
@@ -471,7 +463,7 @@ void Simulation::buildRows() {
     // r_eff the harmonic combination of the rolling radii (the single radius against a flat shape).
     Real rollMu = 0;
     if (mat.getRollingResistanceCoefficient() > 0) {
-      const Real r0 = rollingRadius(c.geometry(0)), r1 = rollingRadius(c.geometry(1));
+      const Real r0 = detail::rollingRadius(c.geometry(0)), r1 = detail::rollingRadius(c.geometry(1));
       const Real reff = (r0 > 0 && r1 > 0) ? r0 * r1 / (r0 + r1) : std::max(r0, r1);
       rollMu = mat.getRollingResistanceCoefficient() * reff;
     }
@@ -659,6 +651,7 @@ void Simulation::buildRows() {
     // Joints couple bodies for support levels too (a chain hanging from the world is supported link by link).
     m.contactRanges.push_back({ctx.indexA, ctx.indexB, begin, uint32_t(m.rows.size() - begin), true});
   }
+  m.nonIterativeRows = nonIterative;
   if (nonIterative && !m.warnedSolveType && !DirectSolver::available()) {
     m.warnedSolveType = true;
     Logger::warningOnce("scree.solveType.direct",
@@ -710,7 +703,8 @@ void Simulation::solve() {
   m.iterSet.clear();
   bool split = false;
   m.pureIterative = false;
-  if (DirectSolver::available())
+  // Scenes whose rows are all ITERATIVE skip the classification (no direct set).
+  if (DirectSolver::available() && (m.nonIterativeRows || particleDirect))
     for (uint32_t i = 0; i < m.rows.size(); ++i) {
       const ConstraintRow& r = m.rows[i];
       const auto t = r.solveType;
