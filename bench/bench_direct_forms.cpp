@@ -5,6 +5,7 @@
 // numeric factorisations, and whether AUTO picks this form. docs/speed-accuracy.md records which form wins.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -121,6 +122,40 @@ void tower10(benchmark::State& st) { runForm(st, stackCase, 0, false); }
 void pyramid20(benchmark::State& st) { runForm(st, stackCase, 0, true); }
 void lump4(benchmark::State& st) { runForm(st, lumpCase, 4, false); }
 void lump8(benchmark::State& st) { runForm(st, lumpCase, 8, false); }
+
+// What the post-step position projection (Solver::setUsePositionProjection) costs: chain20 with DIRECT joints,
+// args {hanging 1 / released 0, projection on 1 / off 0}, 600 steps (10 s) from the start, so the released case
+// covers the whip where the projection works. Counters: mean ms per step, projection factorisations per step,
+// worst joint separation.
+void projection(benchmark::State& state) {
+  using Clock = std::chrono::steady_clock;
+  auto s = chain(20, state.range(0) != 0);
+  s->sim->getSolver().setUsePositionProjection(state.range(1) != 0);
+  for (const auto& c : s->sim->getConstraints()) c->setSolveType(FrictionModel::DIRECT);
+  double total = 0, worst = 0;
+  size_t proj = 0, steps = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    s->step();
+    total += std::chrono::duration<double>(Clock::now() - t0).count();
+    proj += s->sim->getSolver().getStats().numProjectionIterations;
+    ++steps;
+    for (const auto& c : s->sim->getConstraints())
+      if (auto* j = dynamic_cast<const Joint*>(c.get())) worst = std::max(worst, (j->getFrame(0).p - j->getFrame(1).p).norm());
+  }
+  const double n = double(std::max<size_t>(steps, 1));
+  state.counters["ms_per_step"] = total * 1e3 / n;
+  state.counters["projections_per_step"] = double(proj) / n;
+  state.counters["worst_separation_m"] = worst;
+}
+BENCHMARK(projection)
+    ->Args({1, 1})
+    ->Args({1, 0})
+    ->Args({0, 1})
+    ->Args({0, 0})
+    ->Iterations(600)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // Arg: 1 = SCHUR, 2 = KKT.
 #define FORMS(fn) BENCHMARK(fn)->Arg(Solver::SCHUR)->Arg(Solver::KKT)->Unit(benchmark::kMillisecond)->UseRealTime()
