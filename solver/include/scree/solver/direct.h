@@ -21,7 +21,7 @@
 // iterations only the worst one changes per iteration (Murty's single principal pivot, finite for P-matrices).
 // Friction rows whose normal is in the set take the bounds +-mu * lambda_n (a box per direction: projected-cone
 // pairs are solved as scaled boxes here) in an outer loop: bounds frozen from the last pass's normals, the box LCP
-// solved by pivoting, until the bounds stop moving (at most 10 passes). Past `maxPivots` factorisations in all
+// solved by pivoting, until the bounds stop moving. Past `maxPivots` factorisations in all (pivoting and passes)
 // the solve reports failure (the caller finishes the set with PGS and logs it).
 //
 // Equality systems (every row unbounded: joints, a particle lump with infinite friction and adhesion and zero
