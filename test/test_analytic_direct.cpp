@@ -250,15 +250,7 @@ TEST_CASE("a lump of spheres with infinite friction and adhesion falls and lands
   // most m v / h ~ 1e2 N, i.e. 1e2 / 4e8 = 2.5e-7 m; bound on the relative displacement 1e-6 m.
   test::TestWorld w;
   w.addGround();
-  auto glue = std::make_shared<Material>("glue");
-  auto cm = w.sim->getMaterialManager().getOrCreateContactMaterial(glue, glue);
-  cm->setFrictionCoefficient(std::numeric_limits<Real>::infinity());
-  cm->setAdhesion(std::numeric_limits<Real>::infinity(), 0.0);
-  cm->setRestitution(0.0);
-  cm->setSolveType(FrictionModel::DIRECT);
-  auto cg = w.sim->getMaterialManager().getOrCreateContactMaterial(glue, w.material);
-  cg->setRestitution(0.0);
-  cg->setSolveType(FrictionModel::DIRECT);
+  auto glue = w.addGlueMaterial(FrictionModel::DIRECT);
   // A tetrahedron of touching spheres (r = 0.05), base 2 cm above the ground.
   const Real r = 0.05, d = 2 * r;
   const Vec3 base(0, 0, r + 0.02);

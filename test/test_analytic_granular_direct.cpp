@@ -35,15 +35,7 @@ struct LumpRun {
 LumpRun runLump(FrictionModel::SolveType type) {
   test::TestWorld w;
   w.addGround();
-  auto glue = std::make_shared<Material>("glue");
-  auto cm = w.sim->getMaterialManager().getOrCreateContactMaterial(glue, glue);
-  cm->setFrictionCoefficient(std::numeric_limits<Real>::infinity());
-  cm->setAdhesion(std::numeric_limits<Real>::infinity(), 0.0);
-  cm->setRestitution(0.0);
-  cm->setSolveType(type);
-  auto cg = w.sim->getMaterialManager().getOrCreateContactMaterial(glue, w.material);
-  cg->setRestitution(0.0);
-  cg->setSolveType(type);
+  auto glue = w.addGlueMaterial(type);
   auto& ps = w.sim->getGranularBodySystem();
   ps.setMaterial(glue);
   const Real r = 0.05, d = 2 * r;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include <scree/scree.h>
@@ -37,6 +38,20 @@ struct TestWorld : scenes::Scene {
     body->setRotation(q);
     sim->add(body);
     return body;
+  }
+  /// A "glue" material for the manual's DIRECT particle mode: glue-glue friction and adhesion infinite, adhesive
+  /// overlap 0, restitution 0; glue-world (this world's material) restitution 0; both with solve type `type`.
+  MaterialRef addGlueMaterial(FrictionModel::SolveType type) {
+    auto glue = std::make_shared<Material>("glue");
+    auto cm = sim->getMaterialManager().getOrCreateContactMaterial(glue, glue);
+    cm->setFrictionCoefficient(std::numeric_limits<Real>::infinity());
+    cm->setAdhesion(std::numeric_limits<Real>::infinity(), 0.0);
+    cm->setRestitution(0.0);
+    cm->setSolveType(type);
+    auto cg = sim->getMaterialManager().getOrCreateContactMaterial(glue, material);
+    cg->setRestitution(0.0);
+    cg->setSolveType(type);
+    return glue;
   }
   /// Dynamic sphere; mass <= 0 keeps the mass from the geometry.
   RigidBodyRef addSphere(Real radius, const Vec3& pos, Real mass = 1.0) {
