@@ -722,7 +722,11 @@ void Simulation::solve() {
   if (!m.directSet.empty()) {
     // Rigid rows through the hybrid direct/iterative solve, then the particles against its result.
     solveHybrid(split);
-    if (particleDirect) m.granular.finishDirect(granular_, m.rows, m.sb);
+    if (particleDirect) {
+      m.granular.finishDirect(granular_, m.rows, m.sb);
+      // The particle rows are gone again: keep the direct set valid for the position projection (ascending).
+      while (!m.directSet.empty() && m.directSet.back() >= m.rows.size()) m.directSet.pop_back();
+    }
     Real residual = st.lastResidual;
     if (particles && m.granular.hasIterativeUnits()) {
       for (int it = 0; it < iterations; ++it)
