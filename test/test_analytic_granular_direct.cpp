@@ -256,3 +256,30 @@ TEST_CASE("DIRECT particles and DIRECT joints in one scene: both hold, the proje
   CHECK(worstJoint < 5e-3);
   CHECK(worstPair < 1e-9);
 }
+
+TEST_CASE("a 4x4x4 glued particle lump lands on a finite-friction ground without a PGS fallback") {
+  // The ground rows are bounded (normal >= 0, friction within mu * normal), so the landing step needs block
+  // pivoting and several friction passes (bounds refrozen from the last normals). The passes share the
+  // factorisation cap (Solver::setMaxPivots, 50) with the pivoting: measured at most 14 factorisations per step.
+  // (With a separate cap of 10 passes the landing step fell back to PGS.)
+  test::TestWorld w(1.0 / 60.0, 9.81, 0.5);
+  w.addGround();
+  auto glue = w.addGlueMaterial(FrictionModel::DIRECT);
+  auto& ps = w.sim->getGranularBodySystem();
+  ps.setMaterial(glue);
+  const Real r = 0.05, d = 2 * r;
+  for (int z = 0; z < 4; ++z)
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 4; ++x) ps.createParticle(Vec3(x * d, y * d, r + 0.05 + z * d), r);
+  int fallbacks = 0;
+  size_t most = 0;
+  for (int i = 0; i < 30; ++i) {
+    w.sim->stepForward();
+    fallbacks += w.sim->getSolver().getStats().directFallback ? 1 : 0;
+    most = std::max(most, w.sim->getSolver().getStats().numFactorisations);
+  }
+  std::printf("4x4x4 lump landing: %d fallbacks, at most %zu factorisations per step\n", fallbacks, most);
+  CHECK(fallbacks == 0);
+  CHECK(most > 10);  // the landing really needed more than the old pass cap
+  CHECK(most <= 50);
+}
