@@ -50,7 +50,9 @@ struct DirectSolver::Impl {
   std::vector<int32_t> normalLocal;
   std::vector<int> p, i, diagPos;
   std::vector<Real> x0;
-  std::vector<int> mark;
+  std::vector<int> mark, idx;
+  std::vector<std::pair<Real, int>> viol;
+  std::vector<Real> usedLo, usedHi;
 
   Impl() {
     cholmod_start(&cm);
@@ -199,7 +201,7 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
   if (!kkt) {
     m.scratch.assign(n, 0);
     m.mark.assign(n, 0);
-    std::vector<int> idx;
+    std::vector<int>& idx = m.idx;
     for (int j = 0; j < n; ++j) {
       idx.clear();
       for (int s = 0; s < m.numSides[j]; ++s) {
@@ -391,8 +393,9 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
   // the bounds stop moving.
   bool converged = false, failed = false;
   const int maxIter = std::max(1, settings.maxPivots);
-  std::vector<std::pair<Real, int>> viol;
-  std::vector<Real> usedLo, usedHi;
+  auto& viol = m.viol;
+  auto& usedLo = m.usedLo;
+  auto& usedHi = m.usedHi;
   // The passes share the factorisation cap (maxPivots) with the pivoting inside them; no separate pass cap (a
   // cap of 10 passes made a 512-particle glued lump's landing on a finite-friction ground fall back to PGS,
   // where it converges in 24 factorisations).
