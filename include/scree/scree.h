@@ -21,6 +21,7 @@
 #include "scree/collide/uniform_grid.h"
 #include "scree/solver/constraint.h"
 #include "scree/solver/joints.h"
+#include "scree/solver/model.h"
 #include "scree/solver/simulation.h"
 #include "scree/solver/solver.h"
 #include "scree/solver/spook.h"

@@ -110,6 +110,11 @@ struct Simulation::Impl {
 
 Simulation::Simulation() : impl_(std::make_unique<Impl>()) {}
 Simulation::~Simulation() {
+  // Models may own themselves through their items (a tire model is its own constraint): let them go.
+  for (auto& model : models_) {
+    model->owned_.clear();
+    model->sim_ = nullptr;
+  }
   for (auto& b : bodies_) BodyAccess::simIndex(*b) = -1;
 }
 

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <chrono>
+#include <concepts>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -22,6 +23,7 @@
 #include "scree/core/particle_contact.h"
 #include "scree/core/rigid_body.h"
 #include "scree/solver/constraint.h"
+#include "scree/solver/model.h"
 #include "scree/solver/solver.h"
 
 namespace scree {
@@ -70,9 +72,30 @@ class Simulation {
   bool remove(const StepEventListenerRef& listener);
   void add(ContactEventListenerRef listener);
   bool remove(const ContactEventListenerRef& listener);
+  /// A model (terrain, tire, fields, suction, or a user's Model subclass): recorded, then Model::onAdd installs
+  /// its bodies, constraints and listeners; remove() uninstalls them all (scree/solver/model.h). Adding twice is a
+  /// no-op; a model in another simulation throws.
+  void add(ModelRef model);
+  bool remove(const ModelRef& model);
+  /// Models are added through the Model path even when they are also constraints or listeners.
+  template <class T>
+    requires std::derived_from<T, Model>
+  void add(std::shared_ptr<T> model) {
+    add(ModelRef(std::move(model)));
+  }
+  template <class T>
+    requires std::derived_from<T, Model>
+  bool remove(const std::shared_ptr<T>& model) {
+    return remove(ModelRef(model));
+  }
+  const std::vector<ModelRef>& getModels() const { return models_; }
 
   const std::vector<RigidBodyRef>& getRigidBodies() const { return bodies_; }
   const std::vector<ConstraintRef>& getConstraints() const { return constraints_; }
+  /// Geometries added without a body.
+  const std::vector<GeometryRef>& getStaticGeometries() const { return staticGeoms_; }
+  const std::vector<StepEventListenerRef>& getStepEventListeners() const { return stepListeners_; }
+  const std::vector<ContactEventListenerRef>& getContactEventListeners() const { return contactListeners_; }
 
   /// s, finite and > 0. Default 1/60.
   void setTimeStep(Real h);
@@ -133,6 +156,7 @@ class Simulation {
   std::vector<ConstraintRef> constraints_;
   std::vector<StepEventListenerRef> stepListeners_;
   std::vector<ContactEventListenerRef> contactListeners_;
+  std::vector<ModelRef> models_;
   MaterialManager materials_;
   Solver solver_;
   Space space_;
