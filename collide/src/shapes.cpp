@@ -731,6 +731,10 @@ HeightField::HeightField(size_t resolutionX, size_t resolutionY, Real sizeX, Rea
   sx_ = sizeX;
   sy_ = sizeY;
   h_.assign(nx_ * ny_, 0.0);
+  tilesX_ = std::max<size_t>(1, (nx_ - 2) / kTileSize + 1);
+  tilesY_ = std::max<size_t>(1, (ny_ - 2) / kTileSize + 1);
+  tileMin_.assign(tilesX_ * tilesY_, 0.0);
+  tileMax_.assign(tilesX_ * tilesY_, 0.0);
   const Real cx = getCellSizeX(), cy = getCellSizeY();
   if (std::abs(cx - cy) > 1e-9 * std::max(cx, cy)) {
     std::ostringstream s;
@@ -746,16 +750,8 @@ void HeightField::setHeight(size_t i, size_t j, Real h) {
   if (i >= nx_) detail::throwInvalid(where, "i", (long long)i, "must be < resolutionX = " + std::to_string(nx_));
   if (j >= ny_) detail::throwInvalid(where, "j", (long long)j, "must be < resolutionY = " + std::to_string(ny_));
   detail::requireFinite(where, "height", h);
-  Real& cur = h_[j * nx_ + i];
-  const Real old = cur;
-  cur = h;
-  // Incremental bounds when possible; a full rescan only when the old extreme was lowered/raised away.
-  if ((old == minH_ && h > old) || (old == maxH_ && h < old)) updateBounds();
-  else {
-    minH_ = std::min(minH_, h);
-    maxH_ = std::max(maxH_, h);
-  }
-  touch();
+  h_[j * nx_ + i] = h;
+  markDirty(i, j, i, j);
 }
 
 void HeightField::setHeights(const std::vector<Real>& heights) {
@@ -767,14 +763,82 @@ void HeightField::setHeights(const std::vector<Real>& heights) {
     if (!std::isfinite(heights[k]))
       detail::throwInvalid(where, "heights[" + std::to_string(k) + "]", heights[k], "must be finite");
   h_ = heights;
-  updateBounds();
+  markDirty(0, 0, nx_ - 1, ny_ - 1);
+}
+
+void HeightField::setHeights(size_t i0, size_t j0, size_t i1, size_t j1, const std::vector<Real>& values) {
+  constexpr const char* where = "HeightField::setHeights";
+  if (i1 >= nx_) detail::throwInvalid(where, "i1", (long long)i1, "must be < resolutionX = " + std::to_string(nx_));
+  if (j1 >= ny_) detail::throwInvalid(where, "j1", (long long)j1, "must be < resolutionY = " + std::to_string(ny_));
+  if (i0 > i1) detail::throwInvalid(where, "i0", (long long)i0, "must be <= i1 = " + std::to_string(i1));
+  if (j0 > j1) detail::throwInvalid(where, "j0", (long long)j0, "must be <= j1 = " + std::to_string(j1));
+  const size_t w = i1 - i0 + 1, n = w * (j1 - j0 + 1);
+  if (values.size() != n)
+    detail::throwInvalid(where, "values.size()", (long long)values.size(),
+                         "must equal (i1 - i0 + 1) * (j1 - j0 + 1) = " + std::to_string(n));
+  for (size_t k = 0; k < n; ++k)
+    if (!std::isfinite(values[k]))
+      detail::throwInvalid(where, "values[" + std::to_string(k) + "]", values[k], "must be finite");
+  for (size_t j = j0; j <= j1; ++j)
+    std::copy_n(values.begin() + std::ptrdiff_t((j - j0) * w), w, h_.begin() + std::ptrdiff_t(j * nx_ + i0));
+  markDirty(i0, j0, i1, j1);
+}
+
+namespace {
+void growRect(HeightField::Rect& r, size_t i0, size_t j0, size_t i1, size_t j1) {
+  if (r.empty()) {
+    r = {i0, j0, i1, j1};
+    return;
+  }
+  r.i0 = std::min(r.i0, i0);
+  r.j0 = std::min(r.j0, j0);
+  r.i1 = std::max(r.i1, i1);
+  r.j1 = std::max(r.j1, j1);
+}
+}  // namespace
+
+void HeightField::markDirty(size_t i0, size_t j0, size_t i1, size_t j1) {
+  growRect(dirty_, i0, j0, i1, j1);
+  growRect(pending_, i0, j0, i1, j1);
+  if (editDepth_ == 0) {
+    updateBounds(pending_);
+    pending_ = Rect{};
+  }
   touch();
 }
 
-void HeightField::updateBounds() {
-  auto [mn, mx] = std::minmax_element(h_.begin(), h_.end());
-  minH_ = *mn;
-  maxH_ = *mx;
+void HeightField::endHeightEdit() {
+  if (editDepth_ == 0) return;
+  if (--editDepth_ == 0 && !pending_.empty()) {
+    updateBounds(pending_);
+    pending_ = Rect{};
+  }
+}
+
+void HeightField::updateBounds() { updateBounds(Rect{0, 0, nx_ - 1, ny_ - 1}); }
+
+void HeightField::updateBounds(const Rect& r) {
+  // A vertex on a tile seam belongs to both tiles: recompute every tile whose vertex range meets the rectangle.
+  const size_t T = kTileSize;
+  const size_t ti0 = r.i0 == 0 ? 0 : std::min((r.i0 - 1) / T, tilesX_ - 1);
+  const size_t tj0 = r.j0 == 0 ? 0 : std::min((r.j0 - 1) / T, tilesY_ - 1);
+  const size_t ti1 = std::min(r.i1 / T, tilesX_ - 1), tj1 = std::min(r.j1 / T, tilesY_ - 1);
+  for (size_t tj = tj0; tj <= tj1; ++tj)
+    for (size_t ti = ti0; ti <= ti1; ++ti) {
+      const size_t ia = ti * T, ib = std::min(ia + T, nx_ - 1);
+      const size_t ja = tj * T, jb = std::min(ja + T, ny_ - 1);
+      Real mn = h_[ja * nx_ + ia], mx = mn;
+      for (size_t j = ja; j <= jb; ++j) {
+        const auto row = h_.begin() + std::ptrdiff_t(j * nx_);
+        auto [lo, hi] = std::minmax_element(row + std::ptrdiff_t(ia), row + std::ptrdiff_t(ib + 1));
+        mn = std::min(mn, *lo);
+        mx = std::max(mx, *hi);
+      }
+      tileMin_[tj * tilesX_ + ti] = mn;
+      tileMax_[tj * tilesX_ + ti] = mx;
+    }
+  minH_ = *std::min_element(tileMin_.begin(), tileMin_.end());
+  maxH_ = *std::max_element(tileMax_.begin(), tileMax_.end());
 }
 
 Vec3 HeightField::getVertex(size_t i, size_t j) const {

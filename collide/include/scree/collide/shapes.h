@@ -172,6 +172,31 @@ class HeightField : public Shape {
   Real getHeight(size_t i, size_t j) const { return h_[j * nx_ + i]; }
   /// Row-major with i fastest: heights[j * resolutionX + i]. Size must be resolutionX * resolutionY.
   void setHeights(const std::vector<Real>& heights);
+  /// The rectangle of vertices i0 <= i <= i1, j0 <= j <= j1 (inclusive), row-major with i fastest:
+  /// values[(j - j0) * (i1 - i0 + 1) + (i - i0)]. Bounds are updated from the touched tiles only (see
+  /// kTileSize), so a local edit costs the rectangle, not the grid. Everything is checked before anything
+  /// changes: indices in range with i0 <= i1, j0 <= j1, the size, every value finite.
+  void setHeights(size_t i0, size_t j0, size_t i1, size_t j1, const std::vector<Real>& values);
+  /// Batched edits: between beginHeightEdit() and endHeightEdit() (nestable) setHeight/setHeights only write
+  /// heights and grow the dirty rectangle; endHeightEdit() updates the bounds of the touched tiles once.
+  void beginHeightEdit() { ++editDepth_; }
+  void endHeightEdit();
+  /// Vertices changed since the counter was last cleared (inclusive rectangle; empty when i0 > i1). The
+  /// terrain reads it to know what a step touched; clearDirtyRectangle() resets it.
+  struct Rect {
+    size_t i0 = 1, j0 = 1, i1 = 0, j1 = 0;
+    bool empty() const { return i0 > i1 || j0 > j1; }
+  };
+  const Rect& getDirtyRectangle() const { return dirty_; }
+  void clearDirtyRectangle() { dirty_ = Rect{}; }
+  /// Vertices per tile side of the bounds hierarchy: tile (ti, tj) covers vertices [ti*16, ti*16 + 16] in i
+  /// (it shares its last vertex column with the next tile, so every cell lies inside one tile), same in j.
+  static constexpr size_t kTileSize = 16;
+  size_t getNumTilesX() const { return tilesX_; }
+  size_t getNumTilesY() const { return tilesY_; }
+  /// Lowest/highest height of the vertices of tile (ti, tj).
+  Real getTileMinHeight(size_t ti, size_t tj) const { return tileMin_[tj * tilesX_ + ti]; }
+  Real getTileMaxHeight(size_t ti, size_t tj) const { return tileMax_[tj * tilesX_ + ti]; }
   const std::vector<Real>& getHeights() const { return h_; }
   /// Vertex (i, j) in the shape frame.
   Vec3 getVertex(size_t i, size_t j) const;
@@ -184,10 +209,18 @@ class HeightField : public Shape {
 
  private:
   void updateBounds();
+  /// Recomputes the tiles that hold vertices of the rectangle, then the global bounds from the tiles.
+  void updateBounds(const Rect& r);
+  void markDirty(size_t i0, size_t j0, size_t i1, size_t j1);
   size_t nx_, ny_;
   Real sx_, sy_;
   std::vector<Real> h_;
   Real minH_ = 0, maxH_ = 0;
+  size_t tilesX_ = 1, tilesY_ = 1;
+  std::vector<Real> tileMin_, tileMax_;
+  int editDepth_ = 0;
+  Rect pending_;  ///< rectangle edited inside the current batch, bounds not yet updated
+  Rect dirty_;
 };
 
 /// A line segment (sensor rays, suction-cup line sensors). Collides with every shape but Line and Plane's
