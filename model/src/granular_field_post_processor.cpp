@@ -472,11 +472,17 @@ void GranularFieldPostProcessor::writeCsvSlice(const std::string& path, int axis
 
 GranularFieldStepListener::GranularFieldStepListener(GranularFieldPostProcessorRef postProcessor, size_t everyNSteps,
                                                      Callback callback)
-    : StepEventListener(POST_STEP), gpp_(std::move(postProcessor)), every_(everyNSteps), callback_(std::move(callback)) {
+    : StepEventListener(POST_STEP),
+      Model("GranularFieldStepListener"),
+      gpp_(std::move(postProcessor)),
+      every_(everyNSteps),
+      callback_(std::move(callback)) {
   constexpr const char* where = "GranularFieldStepListener";
   detail::requireNonNull(where, "postProcessor", gpp_.get());
   if (everyNSteps < 1) detail::throwInvalid(where, "everyNSteps", (long long)everyNSteps, "must be >= 1");
 }
+
+void GranularFieldStepListener::onAdd(Simulation&) { addOwned(selfAs<StepEventListener>()); }
 
 void GranularFieldStepListener::post(const TimeStamp&) {
   ++numSteps_;

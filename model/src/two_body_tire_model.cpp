@@ -47,6 +47,7 @@ TwoBodyTireModel::TwoBodyTireModel(RigidBodyRef tireBody, Real tireRadius, Rigid
                                    const Vec3& localRotationAxis)
     : Joint(tireBody, rimBody, restFrame(tireBody, tireRadius, rimBody, rimRadius, localRotationAxis).p,
             restFrame(tireBody, tireRadius, rimBody, rimRadius, localRotationAxis).q, NUM_DOFS, "TwoBodyTireModel"),
+      Model("TwoBodyTireModel"),
       tireRadius_(tireRadius),
       rimRadius_(rimRadius),
       localAxis_(localRotationAxis.normalized()) {
@@ -163,6 +164,15 @@ void TwoBodyTireModel::storeResult(const ConstraintRow* rows, const int* dofs, s
   bendingWarm_ = warm_[BENDING_1] * axisX_ + warm_[BENDING_2] * axisY_;
 }
 
+void TwoBodyTireModel::onAdd(Simulation&) {
+  // Adding the constraint already brings the listener in (addNotification); owning it too keeps the model's list
+  // of what it installed complete (getNumOwned() == 2).
+  addOwned(selfAs<Constraint>());
+  addOwned(listener_);
+}
+
+// Both paths (Model and plain ConstraintRef) meet here, so the listener is tied to the constraint's membership.
+// Simulation::add ignores a listener it already has: it is never installed twice.
 void TwoBodyTireModel::addNotification(Simulation& sim) { sim.add(listener_); }
 void TwoBodyTireModel::removeNotification(Simulation& sim) { sim.remove(listener_); }
 

@@ -49,6 +49,7 @@
 
 #include "scree/core/listeners.h"
 #include "scree/core/math.h"
+#include "scree/solver/model.h"
 
 namespace scree {
 
@@ -211,7 +212,11 @@ using GranularFieldPostProcessorRef = std::shared_ptr<GranularFieldPostProcessor
 /// (e.g. to export). A calculation that calculateFields() refuses (a particle too large for the voxels, a
 /// removed custom buffer, a non-finite particle) is logged as an error and skipped; the step is not
 /// interrupted.
-class GranularFieldStepListener : public StepEventListener {
+///
+/// It is a Model (scree/solver/model.h): `sim.add(listener)` takes the Model path, whose onAdd installs it as a
+/// step listener, and `sim.remove(listener)` takes it out. Added as a plain StepEventListenerRef it is just a
+/// listener, as before (not listed in getModels()); remove it the way it was added.
+class GranularFieldStepListener : public StepEventListener, public Model {
  public:
   using Callback = std::function<void(const GranularFieldPostProcessor&, size_t stepIndex)>;
   /// everyNSteps >= 1; a null post-processor or 0 throws std::invalid_argument.
@@ -220,6 +225,12 @@ class GranularFieldStepListener : public StepEventListener {
   /// Steps seen so far (post calls).
   size_t getNumSteps() const { return numSteps_; }
   const GranularFieldPostProcessorRef& getPostProcessor() const { return gpp_; }
+  /// The simulation running the listener (either way it was added), or nullptr. (Model has one too.)
+  using StepEventListener::getSimulation;
+
+ protected:
+  /// Model hook: installs this object as a step listener.
+  void onAdd(Simulation& sim) override;
 
  private:
   GranularFieldPostProcessorRef gpp_;

@@ -26,16 +26,28 @@
 // axle x normal; the second friction row is then along the axle's projection on the contact plane (the
 // lateral, slip-angle direction), as AGX orients a tire's friction frame. setEnableFrictionAlignment(false)
 // turns it off.
+//
+// Adding and removing (the Model hook, scree/solver/model.h). The tire is both a Joint and a Model:
+// `sim.add(tire)` / `sim.remove(tire)` take the Model path (Simulation's template for Model types), and onAdd
+// installs the tire as a constraint and its friction listener with addOwned, so removing the model takes out
+// both. The tire and rim bodies are the user's: add them to the simulation yourself; the model never removes
+// them. The friction listener follows the constraint -- it is in the simulation exactly while the tire's
+// constraint is (Constraint::addNotification / removeNotification) -- so a tire added as a plain constraint,
+// `sim.add(ConstraintRef(tire))`, behaves as before (constraint and listener, no model recorded in
+// getModels()) and is removed with `sim.remove(ConstraintRef(tire))`. The listener is never installed twice.
+// Do not mix the two: a tire added with `sim.add(tire)` is taken out with `sim.remove(tire)`; removing only its
+// ConstraintRef takes out the constraint and the listener but leaves the model listed until sim.remove(tire).
 #pragma once
 
 #include <memory>
 
 #include "scree/core/listeners.h"
 #include "scree/solver/joints.h"
+#include "scree/solver/model.h"
 
 namespace scree {
 
-class TwoBodyTireModel : public Joint {
+class TwoBodyTireModel : public Joint, public Model {
  public:
   enum DeformationMode { RADIAL = 0, LATERAL, BENDING, TORSIONAL, NUM_MODES };
   /// Constraint DOFs (getCurrentForce(dof), getLastForces()).
@@ -91,10 +103,15 @@ class TwoBodyTireModel : public Joint {
   // ---- used by the simulation -------------------------------------------------------------------------------
   void addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) override;
   void storeResult(const ConstraintRow* rows, const int* dofs, size_t count, Real h) override;
+  /// Install / uninstall the friction listener together with the constraint (file comment).
   void addNotification(Simulation& sim) override;
   void removeNotification(Simulation& sim) override;
   /// Sets the friction direction of the tire's points in `contact` (what the listener calls).
   void alignFriction(GeometryContact& contact) const;
+
+ protected:
+  /// Model hook: the tire as a constraint, then its friction listener.
+  void onAdd(Simulation& sim) override;
 
  private:
   static void checkMode(const char* where, DeformationMode mode);
