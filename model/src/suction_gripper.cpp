@@ -1,9 +1,10 @@
 // SuctionGripper, SuctionCup, VacuumSystem, SuctionCupInteraction (model layer; see suction_gripper.h).
 //
-// The gripper attaches through public hooks only: sensor geometries on the cup bodies, a ContactEventListener
-// (filtered to the gripper's collision group) that turns sensor contacts into interactions, and its own
-// StepEventListener stages: preCollide clears the interactions, pre runs the vacuum system and applies the forces
-// (RigidBody::addForceAtPosition, consumed by this step's solve), post reads the cup-body contacts' forces.
+// The gripper attaches through public hooks only: the Model hook installs (and removal takes out) its items;
+// sensor geometries on the cup bodies, a ContactEventListener (filtered to the gripper's collision group) that
+// turns sensor contacts into interactions, and its own StepEventListener stages: preCollide clears the
+// interactions, pre runs the vacuum system and applies the forces (RigidBody::addForceAtPosition, consumed by
+// this step's solve), post reads the cup-body contacts' forces.
 #include "scree/model/suction_gripper.h"
 
 #include <algorithm>
@@ -197,7 +198,7 @@ class SuctionGripper::SensorListener : public ContactEventListener {
     if (gripper_) gripper_->onSensorContact(c);
     return KEEP_CONTACT;
   }
-  /// The simulation may outlive the gripper (if the user removed it): the listener then does nothing.
+  /// Called by the gripper's destructor: should anything still hold the listener, it never calls a dead gripper.
   void detach() { gripper_ = nullptr; }
 
  private:
@@ -219,7 +220,10 @@ class GroupSensorFilter : public ExecuteFilter {
 }  // namespace
 
 SuctionGripper::SuctionGripper()
-    : StepEventListener(ALL), vacuum_(std::make_shared<VacuumSystem>()), group_(nextGripperGroup()) {
+    : StepEventListener(ALL),
+      Model("SuctionGripper"),
+      vacuum_(std::make_shared<VacuumSystem>()),
+      group_(nextGripperGroup()) {
   listener_ = std::make_shared<SensorListener>(this);
   listener_->setFilter(std::make_shared<GroupSensorFilter>(group_));
 }
@@ -230,7 +234,8 @@ void SuctionGripper::setHolderRigidBody(RigidBodyRef holder) {
   detail::requireNonNull("SuctionGripper::setHolderRigidBody", "holder", holder.get());
   holder_ = std::move(holder);
   for (const GeometryRef& g : holder_->getGeometries()) g->addGroup(group_);
-  if (installedIn_) installedIn_->add(holder_);
+  // A replaced holder stays installed (cups may still be locked to it) and leaves with the gripper.
+  installBody(holder_);
 }
 
 void SuctionGripper::setVacuumSystem(VacuumSystemRef vacuumSystem) {
@@ -245,6 +250,7 @@ void SuctionGripper::add(SuctionCupRef cup) {
     throw std::invalid_argument("SuctionGripper::add: cup is invalid (it belongs to another gripper)");
   cup->gripper_ = this;
   registerCup(*cup);
+  installBody(cup->getRigidBody());
   cups_.push_back(std::move(cup));
 }
 
@@ -267,7 +273,7 @@ void SuctionGripper::add(SuctionCupRef cup, const Vec3& localPosition, const Qua
   cup->mount_ = joint;
   cup->mountLocal_ = {localPosition, localRotation.normalized()};
   add(std::move(cup));
-  if (installedIn_) installedIn_->add(joints_.back());
+  addOwned(joints_.back());  // after its body: no joint in the simulation to a body that is not
 }
 
 void SuctionGripper::registerCup(SuctionCup& cup) {
@@ -277,16 +283,38 @@ void SuctionGripper::registerCup(SuctionCup& cup) {
   cupBodies_[cup.getRigidBody().get()] = &cup;
 }
 
-void SuctionGripper::install(Simulation& sim) {
-  if (installedIn_ != &sim) {
-    installedIn_ = &sim;
-    installedCups_ = 0;
-    sim.add(listener_);
-    sim.setEnableCollisions(group_, group_, false);
-    if (holder_) sim.add(holder_);
-    for (const auto& j : joints_) sim.add(j);
+void SuctionGripper::installBody(const RigidBodyRef& body) {
+  Simulation* sim = Model::getSimulation();
+  if (!sim) return;  // onAdd installs it when the gripper is added
+  // A body already in the simulation was put there by the user (or is owned already): not ours to remove.
+  const auto& bodies = sim->getRigidBodies();
+  if (std::find(bodies.begin(), bodies.end(), body) != bodies.end()) return;
+  addOwned(body);
+}
+
+void SuctionGripper::onAdd(Simulation& sim) {
+  addOwned(selfAs<StepEventListener>());
+  addOwned(ContactEventListenerRef(listener_));
+  sim.setEnableCollisions(group_, group_, false);
+  if (holder_) installBody(holder_);
+  for (const auto& cup : cups_) installBody(cup->getRigidBody());
+  for (const auto& j : joints_) addOwned(j);
+}
+
+void SuctionGripper::onRemove(Simulation& sim) {
+  // Group ids are unique per gripper, so nothing else had changed this pair: back to the default.
+  sim.setEnableCollisions(group_, group_, true);
+  for (const auto& cup : cups_) {
+    if (cup->kinematicMount_) {  // undo updateMounts(): a body the user keeps must move on its own again
+      cup->getRigidBody()->setMotionControl(RigidBody::DYNAMICS);
+      cup->mount_->setEnable(true);
+      cup->kinematicMount_ = false;
+    }
+    cup->active_.clear();
+    cup->vacuumInteraction_ = nullptr;
+    cup->availableForce_ = 0;
   }
-  for (; installedCups_ < cups_.size(); ++installedCups_) sim.add(cups_[installedCups_]->getRigidBody());
+  anyInteraction_ = false;
 }
 
 void SuctionGripper::updateMounts() {
@@ -320,9 +348,11 @@ void SuctionGripper::updateMounts() {
 }
 
 void SuctionGripper::preCollide(const TimeStamp&) {
-  Simulation* sim = getSimulation();
+  Simulation* sim = StepEventListener::getSimulation();
   if (!sim) return;
-  if (installedIn_ != sim || installedCups_ != cups_.size()) install(*sim);
+  // Added as a plain StepEventListenerRef: install the rest through the Model hook now (the gripper is already
+  // in the listener list, so the list this stage walks does not grow).
+  if (!Model::getSimulation()) sim->add(selfAs<Model>());
   updateMounts();
   for (const auto& cup : cups_) {
     cup->active_.clear();

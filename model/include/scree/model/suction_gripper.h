@@ -2,10 +2,12 @@
 // that one VacuumSystem powers.
 //
 // Pieces (each can be subclassed as the manual shows):
-//   SuctionGripper         a StepEventListener: `sim.add(gripper)` is all a user does; at the start of the next
-//                          step it adds the holder, the cup bodies, the lock joints made by add(cup, pose) and its
-//                          contact listener to the simulation, and puts all its geometries in one collision group
-//                          that does not collide with itself (sensors ignore the holder and the cups).
+//   SuctionGripper         a Model and a StepEventListener: `sim.add(gripper)` is all a user does. The Model hook
+//                          (scree/solver/model.h) installs at once the gripper as a step listener, its contact
+//                          listener, the holder and cup bodies not yet in the simulation, and the lock joints made
+//                          by add(cup, pose); cups added later are installed as they come. All its geometries are
+//                          in one collision group that does not collide with itself (sensors ignore the holder and
+//                          the cups). `sim.remove(gripper)` takes out everything it installed.
 //   SuctionCup             a rigid body (default: a cylinder of the lip radius and lip height, axis along the
 //                          body's local z, lip at the body origin) with a Line sensor from the body origin along the
 //                          line sensor vector and `sealResolution` sphere sensors of radius `sealSensorReach` on the
@@ -47,11 +49,18 @@
 // from then on, e.g. in a pre-step listener and after the step); vacuum forces are applied in the pre stage; the
 // contact read-outs (normal and friction force, relative speed between cup and body) are filled in the post stage.
 //
-// Limitations: removing a gripper from a simulation is not supported yet (remove its listener and bodies by hand).
-// Light cup bodies locked to a *dynamic* holder (several cups on a robot-driven holder) are a hard case for PGS:
-// a box pulled with hundreds of newtons against 20 g - 2 kg cups makes the cups wobble centimetres on their locks
-// and the box slip out at 16 iterations. A dynamic holder can carry one cup whose body is the holder itself
-// (examples/demo_suction.h); several cups on a dynamic holder need the DIRECT solver (a later issue).
+// Adding and removing. Bodies that were already in the simulation when the gripper installed them (a holder the
+// user added, a cup whose body is the holder) stay the user's: removing the gripper leaves them in. Removing it
+// takes out its listeners, the lock joints and the bodies it added, turns a cup it made KINEMATICS back to
+// DYNAMICS with its lock enabled, and re-enables collisions within its group. A gripper added as a plain
+// StepEventListenerRef installs itself through the same hook at its first step; remove it with sim.remove(gripper).
+//
+// Limitations: light cup bodies locked to a *dynamic* holder (several cups on a robot-driven holder) are a hard
+// case for PGS: a box pulled with hundreds of newtons against 20 g - 2 kg cups makes the cups wobble centimetres
+// on their locks and the box slip out at 16 iterations. A dynamic holder can carry one cup whose body is the
+// holder itself (examples/demo_suction.h), the arrangement the tests cover. The locks' default solve type
+// (DIRECT_AND_ITERATIVE) gives them to the direct solver; several cups on a dynamic holder have not been measured
+// with it.
 #pragma once
 
 #include <cstddef>
@@ -65,6 +74,7 @@
 #include "scree/core/math.h"
 #include "scree/core/rigid_body.h"
 #include "scree/solver/constraint.h"
+#include "scree/solver/model.h"
 
 namespace scree {
 
@@ -252,8 +262,8 @@ class SuctionCup {
 };
 using SuctionCupRef = std::shared_ptr<SuctionCup>;
 
-/// Holder body + cups + vacuum system (an assembly in AGX). Add it to a simulation as a StepEventListener.
-class SuctionGripper : public StepEventListener {
+/// Holder body + cups + vacuum system (an assembly in AGX). Add it to a simulation with sim.add(gripper) (a Model).
+class SuctionGripper : public StepEventListener, public Model {
  public:
   /// A default VacuumSystem (desired vacuum 0.2) and no holder yet.
   SuctionGripper();
@@ -280,10 +290,18 @@ class SuctionGripper : public StepEventListener {
   const std::vector<ConstraintRef>& getMountJoints() const { return joints_; }
   /// Collision group of the holder, cup and sensor geometries (disabled against itself).
   uint32_t getCollisionGroup() const { return group_; }
+  /// The simulation running the gripper, or nullptr. (Model has one too; they agree once it is installed.)
+  using StepEventListener::getSimulation;
 
   void preCollide(const TimeStamp& t) override;
   void pre(const TimeStamp& t) override;
   void post(const TimeStamp& t) override;
+
+ protected:
+  /// Model hook (file comment): installs the listeners, bodies and lock joints / undoes the gripper's changes
+  /// to its cups and collision group before the hook removes what it installed.
+  void onAdd(Simulation& sim) override;
+  void onRemove(Simulation& sim) override;
 
  private:
   class SensorListener;
@@ -291,7 +309,7 @@ class SuctionGripper : public StepEventListener {
     SuctionCup* cup;
     int seal;  // -1: line sensor, else seal sensor index
   };
-  void install(Simulation& sim);
+  void installBody(const RigidBodyRef& body);
   void registerCup(SuctionCup& cup);
   void updateMounts();
   void onSensorContact(const GeometryContact& contact);
@@ -304,8 +322,6 @@ class SuctionGripper : public StepEventListener {
   std::unordered_map<const Geometry*, SensorInfo> sensors_;
   std::unordered_map<const RigidBody*, SuctionCup*> cupBodies_;
   std::shared_ptr<SensorListener> listener_;
-  Simulation* installedIn_ = nullptr;
-  size_t installedCups_ = 0;
   bool anyInteraction_ = false;
 };
 using SuctionGripperRef = std::shared_ptr<SuctionGripper>;
