@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <mutex>
+#include <string>
 #include <unordered_map>
 
 #include "scree/core/errors.h"
@@ -43,20 +44,20 @@ Geometry::Geometry(ShapeRef shape, const std::string& name) : name_(name), id_(0
 void Geometry::setLocalPosition(const Vec3& p) {
   detail::requireFinite("Geometry::setLocalPosition", "position", p);
   local_.p = p;
-  if (body_) body_->updateMassProperties();
+  if (RigidBody* b = getRigidBody()) b->updateMassProperties();
   updateTransform();
 }
 
 void Geometry::setLocalRotation(const Quat& q) {
   detail::requireRotation("Geometry::setLocalRotation", "rotation", q);
   local_.q = q.normalized();
-  if (body_) body_->updateMassProperties();
+  if (RigidBody* b = getRigidBody()) b->updateMassProperties();
   updateTransform();
 }
 
 void Geometry::setPosition(const Vec3& p) {
   detail::requireFinite("Geometry::setPosition", "position", p);
-  if (body_) setLocalPosition(body_->getTransform().applyInverse(p));
+  if (const RigidBody* b = getRigidBody()) setLocalPosition(b->getTransform().applyInverse(p));
   else {
     local_.p = p;
     updateTransform();
@@ -65,7 +66,7 @@ void Geometry::setPosition(const Vec3& p) {
 
 void Geometry::setRotation(const Quat& q) {
   detail::requireRotation("Geometry::setRotation", "rotation", q);
-  if (body_) setLocalRotation(body_->getRotation().conjugate() * q.normalized());
+  if (const RigidBody* b = getRigidBody()) setLocalRotation(b->getRotation().conjugate() * q.normalized());
   else {
     local_.q = q.normalized();
     updateTransform();
@@ -73,13 +74,29 @@ void Geometry::setRotation(const Quat& q) {
 }
 
 void Geometry::updateTransform() {
-  if (body_) world_ = body_->getTransform() * local_;
+  if (const RigidBody* b = getRigidBody()) world_ = b->getTransform() * local_;
   else world_ = local_;
+}
+
+MassProperties Geometry::getMassPropertiesInBody() const {
+  // Sensors and shapes without volume (plane, line, height field) carry no mass. No material: the default
+  // density (MaterialDefaults::density).
+  if (sensor_ || !(shape_->getVolume() > 0)) return {};
+  const Real density = material_ ? material_->getDensity() : MaterialDefaults::density;
+  const MassProperties mp = shape_->computeMassProperties(density);
+  if (!(mp.mass > 0)) return {};
+  // From the shape frame to the body frame: c = T c_shape, I = R I_shape R^T (inertia rotated into body axes).
+  const Mat3 r = local_.q.toRotationMatrix();
+  return {mp.mass, local_.apply(mp.cm), r * mp.inertia * r.transpose()};
+}
+
+std::string Geometry::describePart() const {
+  return "geometry \"" + name_ + "\" (id " + std::to_string(id_) + ")";
 }
 
 void Geometry::setMaterial(MaterialRef m) {
   material_ = std::move(m);
-  if (body_) body_->updateMassProperties();
+  if (RigidBody* b = getRigidBody()) b->updateMassProperties();
 }
 
 void Geometry::addGroup(uint32_t id) {

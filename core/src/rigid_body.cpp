@@ -1,7 +1,9 @@
 #include "scree/core/rigid_body.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <atomic>
+#include <stdexcept>
 
 #include "scree/core/errors.h"
 
@@ -16,7 +18,71 @@ uint32_t nextBodyId() {
 
 RigidBody::RigidBody(const std::string& name) : name_(name), id_(nextBodyId()) {}
 
+// A part that outlives its body (the user keeps the geometry) must not keep a dangling body pointer.
+RigidBody::~RigidBody() {
+  for (BodyPart* p : parts_) p->body_ = nullptr;
+}
 
+// ---- geometries and mass properties --------------------------------------------------------------------------
+//
+// Mass properties of a body = sum over its parts (geometries) of each part's mass properties in the body frame
+// (BodyPart::getMassPropertiesInBody: a geometry gives its shape's at the material's density, placed by its
+// local transform; sensors and shapes without volume give none):
+//   m = sum m_i,  c = sum m_i c_i / m
+//   I = sum [ I_i + m_i (|d_i|^2 1 - d_i d_i^T) ],  d_i = c_i - c    (parallel-axis theorem)
+// applyComputedMass then applies explicit overrides (setMass, setInertiaTensor, setCmLocal).
+
+void RigidBody::attach(GeometryRef geometry, BodyPart* part) {
+  detail::requireNonNull("RigidBody::add", "geometry", part);
+  if (part->body_ != nullptr)
+    throw std::invalid_argument("RigidBody::add: " + part->describePart() + " is already attached to a body");
+  part->body_ = this;
+  geometries_.push_back(std::move(geometry));
+  parts_.push_back(part);
+  updateMassProperties();
+  part->onBodyChanged();
+}
+
+bool RigidBody::remove(const GeometryRef& geometry) {
+  if (!geometry) return false;
+  auto it = std::find(geometries_.begin(), geometries_.end(), geometry);
+  if (it == geometries_.end()) return false;
+  const auto i = it - geometries_.begin();
+  BodyPart* part = parts_[size_t(i)];
+  geometries_.erase(it);
+  parts_.erase(parts_.begin() + i);
+  part->body_ = nullptr;
+  part->onBodyChanged();  // without a body the local transform is the world placement
+  updateMassProperties();
+  return true;
+}
+
+void RigidBody::updateMassProperties() {
+  // Bodies carry a handful of geometries; a small local vector is fine here (not a per-step path).
+  std::vector<MassProperties> parts;
+  parts.reserve(parts_.size());
+  Real mass = 0;
+  Vec3 moment = Vec3::Zero();
+  for (const BodyPart* part : parts_) {
+    const MassProperties p = part->getMassPropertiesInBody();
+    if (!(p.mass > 0)) continue;
+    mass += p.mass;
+    moment += p.mass * p.cm;
+    parts.push_back(p);
+  }
+  if (!(mass > 0)) {
+    applyComputedMass(0, Vec3::Zero(), Mat3::Zero());
+    return;
+  }
+  const Vec3 cm = moment / mass;
+  Mat3 inertia = Mat3::Zero();
+  for (const MassProperties& p : parts) {
+    const Vec3 d = p.cm - cm;
+    inertia += p.inertia + p.mass * (Mat3::Identity() * d.squaredNorm() - d * d.transpose());
+  }
+  inertia = (0.5 * (inertia + inertia.transpose())).eval();
+  applyComputedMass(mass, cm, inertia);
+}
 
 void RigidBody::setMotionControl(MotionControl m) {
   if (m != STATIC && m != KINEMATICS && m != DYNAMICS)

@@ -1,5 +1,6 @@
 // Geometry (AGX: agxCollide::Geometry): one shape placed in a body frame (or in the world when it has no
-// body), with a material, sensor flag, collision switch, collision groups and a property container.
+// body), with a material, sensor flag, collision switch, collision groups and a property container. To its body
+// it is a BodyPart (scree/core/body_part.h): it gives its shape's mass properties in the body frame.
 #pragma once
 
 #include <cstdint>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "scree/collide/shapes.h"
+#include "scree/core/body_part.h"
 #include "scree/core/material.h"
 #include "scree/core/math.h"
 #include "scree/core/property_container.h"
@@ -15,7 +17,7 @@
 
 namespace scree {
 
-class Geometry {
+class Geometry : public BodyPart {
  public:
   /// shape must not be null.
   explicit Geometry(ShapeRef shape, const std::string& name = "");
@@ -44,7 +46,7 @@ class Geometry {
   /// World AABB of the shape at the current transform.
   Aabb getBoundingBox() const { return shape_->getBoundingBox(world_); }
 
-  RigidBody* getRigidBody() const { return body_; }
+  // getRigidBody(): the body it is attached to, or nullptr (from BodyPart).
 
   void setMaterial(MaterialRef m);
   /// May be null: the simulation's default material is used.
@@ -69,15 +71,16 @@ class Geometry {
   const PropertyContainer& getPropertyContainer() const { return props_; }
 
  private:
-  friend class RigidBody;
-  void setRigidBody(RigidBody* b) { body_ = b; }
+  // BodyPart, called by the body.
+  MassProperties getMassPropertiesInBody() const override;
+  void onBodyChanged() override { updateTransform(); }
+  std::string describePart() const override;
 
   ShapeRef shape_;
   std::string name_;
   uint32_t id_;
   Transform local_;
   Transform world_;
-  RigidBody* body_ = nullptr;
   MaterialRef material_;
   bool sensor_ = false;
   bool collisions_ = true;

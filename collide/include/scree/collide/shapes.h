@@ -12,16 +12,10 @@
 #include <memory>
 #include <vector>
 
+#include "scree/core/body_part.h"  // MassProperties
 #include "scree/core/math.h"
 
 namespace scree {
-
-/// Mass, centre of mass (shape frame) and inertia tensor about the centre of mass (shape axes).
-struct MassProperties {
-  Real mass = 0;
-  Vec3 cm = Vec3::Zero();
-  Mat3 inertia = Mat3::Zero();
-};
 
 class Shape {
  public:

@@ -9,15 +9,19 @@
 // inertia by newMass/computedMass so the radius of gyration is kept). A body with no massive geometry has 1 kg
 // and unit inertia until set. STATIC and KINEMATICS bodies have infinite mass in the solver.
 //
-// add(), remove(), updateMassProperties() and the destructor (which detaches the geometries) are defined in
-// scree_collide: they need the shapes.
+// Layering: RigidBody is core and knows a geometry only as a BodyPart (scree/core/body_part.h), the interface
+// core declares and Geometry implements. add(geometry) is a template for that reason alone: the conversion of
+// the caller's Geometry pointer to its BodyPart base needs Geometry's definition, which the caller has (it made
+// or holds the geometry) and core does not. Calls read as before: body->add(geometry), body->add(nullptr).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "scree/core/body_part.h"
 #include "scree/core/math.h"
 
 namespace scree {
@@ -46,10 +50,16 @@ class RigidBody {
   MotionControl getMotionControl() const { return motion_; }
   bool isDynamic() const { return motion_ == DYNAMICS; }
 
-  // --- geometries and mass (defined in scree_collide) -------------------------------------------------
-  /// Attaches `geometry` (its local frame is relative to this body) and recomputes mass properties.
-  /// Throws if geometry is null or already attached to a body.
-  void add(GeometryRef geometry);
+  // --- geometries and mass ------------------------------------------------------------------------------
+  /// Attaches `geometry` (a GeometryRef; its local frame is relative to this body) and recomputes mass
+  /// properties. Throws if geometry is null or already attached to a body.
+  template <class G>
+  void add(std::shared_ptr<G> geometry) {
+    BodyPart* part = geometry.get();  // here, where G is complete (see the file comment)
+    attach(GeometryRef(std::move(geometry)), part);
+  }
+  /// Null: throws std::invalid_argument, as any null geometry.
+  void add(std::nullptr_t) { attach(nullptr, nullptr); }
   /// Detaches; returns false when it was not attached here.
   bool remove(const GeometryRef& geometry);
   const std::vector<GeometryRef>& getGeometries() const { return geometries_; }
@@ -114,6 +124,7 @@ class RigidBody {
 
  private:
   friend struct detail::BodyAccess;
+  void attach(GeometryRef geometry, BodyPart* part);
   void applyComputedMass(Real mass, const Vec3& cm, const Mat3& inertia);
   void setInertiaInternal(const Mat3& inertia);
 
@@ -144,6 +155,7 @@ class RigidBody {
   Real computedMass_ = 1;
 
   std::vector<GeometryRef> geometries_;
+  std::vector<BodyPart*> parts_;  // parts_[i] is geometries_[i] seen as a BodyPart
   // Index in the simulation's body list, or -1.
   int simIndex_ = -1;
 };
