@@ -36,7 +36,6 @@
 //                   on the locked assembly, but it spares the solver a light cup body (20 g by default) loaded
 //                   with ~100 N that the lock must cancel every step (PGS at 10 iterations leaves a few per cent of
 //                   that as joint error, enough to tip a box held by two cups).
-
 //   fraction        1 for the interaction whose body the line sensor meets first (the surface the cup faces), 0 for
 //                   the others: a cup pulls on one surface. Interactions that only seal sensors touch get no force.
 //

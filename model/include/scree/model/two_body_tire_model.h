@@ -35,8 +35,8 @@
 // constraint is (Constraint::addNotification / removeNotification) -- so a tire added as a plain constraint,
 // `sim.add(ConstraintRef(tire))`, behaves as before (constraint and listener, no model recorded in
 // getModels()) and is removed with `sim.remove(ConstraintRef(tire))`. The listener is never installed twice.
-// Do not mix the two: a tire added with `sim.add(tire)` is taken out with `sim.remove(tire)`; removing only its
-// ConstraintRef takes out the constraint and the listener but leaves the model listed until sim.remove(tire).
+// Remove a tire the way it was added: after `sim.add(tire)`, removing only its ConstraintRef takes out the
+// constraint and the listener but leaves the model listed in getModels() until `sim.remove(tire)`.
 #pragma once
 
 #include <memory>
