@@ -82,7 +82,7 @@ TEST_CASE("chain20 (100:1) released from horizontal: DIRECT stays connected wher
   const auto fine = runChain(false, FrictionModel::DIRECT, 1.0 / 600, 6000, 10);
   // Without the projection the same solve drifts by centimetres (6.5 cm): the projection is what holds it.
   const auto unprojected = runChain(false, FrictionModel::DIRECT, 1.0 / 60, 600, 10, -1, false);
-  // PGS (10 iterations) separates by metres (every engine in SCENES.md explodes here); its rows are ITERATIVE,
+  // PGS (10 iterations) separates by metres (every engine in docs/scenes.md explodes); its rows are ITERATIVE,
   // so the projection does not touch them.
   const auto pgs = runChain(false, FrictionModel::ITERATIVE, 1.0 / 60, 600, 10);
   std::printf("chain20 released: DIRECT dt 1/60 %.3e m (drift before projection up to %.3e m, unprojected "

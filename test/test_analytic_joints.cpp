@@ -210,7 +210,7 @@ TEST_SUITE("joints") {
   }
 
   TEST_CASE("20-link chain with a 100 kg end mass: worst joint error with PGS is recorded") {
-    // chain20 of SCENES.md (the scene's 10 iterations), hanging at rest and released from horizontal.
+    // chain20 of docs/scenes.md (the scene's 10 iterations), hanging at rest and released from horizontal.
     auto measure = [](bool hanging) {
       scenes::Chain20Scene s = scenes::buildChain20(100.0, hanging);
       for (auto& j : s.joints) j->setSolveType(FrictionModel::ITERATIVE);  // joints default to the direct solver
@@ -221,7 +221,7 @@ TEST_SUITE("joints") {
     std::printf("chain20 (100:1) PGS 10 iterations: hanging worst joint error %.3e m, released from horizontal "
                 "%.3e m (first > 0.1 m at %.2f s)\n",
                 hanging.maxSeparation, released.maxSeparation, released.firstAbove10cm);
-    // Recorded, not asserted: PGS at 10 iterations does not hold a 100:1 chain (every engine in SCENES.md
+    // Recorded, not asserted: PGS at 10 iterations does not hold a 100:1 chain (every engine in docs/scenes.md
     // explodes on it); the DIRECT solver issue is where it gets its bound. A 1:1 chain does hold:
     scenes::Chain20Scene light = scenes::buildChain20(1.0, true);
     for (auto& j : light.joints) j->setSolveType(FrictionModel::ITERATIVE);

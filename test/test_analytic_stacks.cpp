@@ -1,9 +1,10 @@
-// Stacks at rest: the analytic answer is "nothing moves". tower10 and pyramid20 (bench/scenes, SCENES.md) must
-// stand 10 s (600 steps at 1/60) with every box within 1 cm of its start; mass_ratio (1000 kg on 1 kg) must hold.
+// Stacks at rest: the analytic answer is "nothing moves". tower10 and pyramid20 (bench/scenes, docs/scenes.md)
+// must stand 10 s (600 steps at 1/60) with every box within 1 cm of its start; mass_ratio (1000 kg on 1 kg) must
+// hold.
 //
-// Iterations: SCENES.md runs every engine with 10 solver iterations; Scree's default is 16. The asserting cases
-// below use the engine default 16 (stated in each MESSAGE); a sweep case reports the drift for other counts
-// without asserting, to tell which count the scenes need.
+// Iterations: docs/scenes.md runs every engine with 10 solver iterations; Scree's default is 16. The asserting
+// cases below use the engine default 16 (stated in each MESSAGE); a sweep case reports the drift for other
+// counts without asserting, to tell which count the scenes need.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -15,7 +16,7 @@ using namespace scree;
 using namespace scree::scenes;
 
 namespace {
-// 1 cm per box: the SCENES.md goal for tower10 ("drift under 1 cm"). Contact compliance accounts for
+// 1 cm per box: the docs/scenes.md goal for tower10 ("drift under 1 cm"). Contact compliance accounts for
 // micrometres (1 kg on 4 points of E = 4e8 N/m: 6 nm per box; the bottom of the tower 10x that), so anything
 // near 1 cm is solver error.
 constexpr Real kMaxDrift = 0.01;
@@ -48,7 +49,7 @@ TEST_CASE("pyramid20 stands 10 s with every box within 1 cm (16 iterations)") {
 TEST_CASE("mass_ratio: 1000 kg on 1 kg holds, heavy box within 1 cm of 1.5 m (scene's 10 iterations)") {
   // Bound 1 cm on the final and on the worst height error over the run: compliance alone sinks the heavy box
   // by (1000 + 1001) kg g / (4 E) ~ 12 micrometres; ODE's direct solver holds it 6 mm low, Bullet, Jolt and
-  // ODE QuickStep squeeze the light box out (SCENES.md). The light box must stay under the heavy one.
+  // ODE QuickStep squeeze the light box out (docs/scenes.md). The light box must stay under the heavy one.
   MassRatioScene s = buildMassRatio();
   const MassRatioMetrics m = runMassRatio(s);
   MESSAGE("mass_ratio, " << s.sim->getSolver().getNumIterations() << " iterations: heavy error "
