@@ -51,7 +51,7 @@
 // Light cup bodies locked to a *dynamic* holder (several cups on a robot-driven holder) are a hard case for PGS:
 // a box pulled with hundreds of newtons against 20 g - 2 kg cups makes the cups wobble centimetres on their locks
 // and the box slip out at 16 iterations. A dynamic holder can carry one cup whose body is the holder itself
-// (examples/demo_suction.h); several cups on a dynamic holder need the DIRECT solver (a later issue).
+// (examples/demo_suction.h); several cups on one dynamic holder with DIRECT solve types is untested so far.
 #pragma once
 
 #include <cstddef>
