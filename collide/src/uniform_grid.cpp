@@ -128,10 +128,13 @@ void UniformGrid::findPairs(const std::vector<Aabb>& boxes, std::vector<std::pai
 
   // --- 3. pairs within each bucket, owner-cell rule -----------------------------------------------------
   const size_t nk = cellKeys_.size();
+  numCellEntries_ = nk;
+  size_t tests = 0;
   for (size_t s = 0; s < nk;) {
     const uint32_t key = uint32_t(cellKeys_[s] >> 32);
     size_t e = s + 1;
     while (e < nk && uint32_t(cellKeys_[e] >> 32) == key) ++e;
+    tests += (e - s) * (e - s - 1) / 2;
     for (size_t p = s; p < e; ++p) {
       const uint32_t a = uint32_t(cellKeys_[p]);
       const Aabb& ba = boxes[a];
@@ -148,6 +151,9 @@ void UniformGrid::findPairs(const std::vector<Aabb>& boxes, std::vector<std::pai
   }
 
   // --- 4. oversize boxes against everything ---------------------------------------------------------------
+  const size_t no = oversize_.size();
+  if (no > 0) tests += no * finite_.size() + no * (no - 1) / 2;
+  numCandidateTests_ = tests;
   for (size_t k = 0; k < oversize_.size(); ++k) {
     const uint32_t o = oversize_[k];
     const Aabb& bo = boxes[o];
