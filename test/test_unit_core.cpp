@@ -7,6 +7,8 @@
 
 #include <scree/scree.h>
 
+#include "test_build.h"
+
 using namespace scree;
 
 TEST_SUITE("core") {
@@ -55,6 +57,12 @@ TEST_SUITE("core") {
     setAssertHandler(old);
     CHECK(calls == 1);
     CHECK(std::string(getConfigurationString()).find("Scree") == 0);
+  }
+
+  TEST_CASE("the configuration string and the compile definition agree on the direct solver") {
+    // Tests pick DIRECT cases by the compile definition (test_build.h); the runtime string must say the same.
+    const std::string config = getConfigurationString();
+    CHECK(config.find(test::kHasDirectSolver ? "SuiteSparse on" : "SuiteSparse off") != std::string::npos);
   }
 
   TEST_CASE("materials combine as springs in series, geometric means and sums") {
