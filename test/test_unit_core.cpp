@@ -23,11 +23,17 @@ TEST_SUITE("core") {
     Logger::setLevel(LogLevel::WARNING);
     Logger::warningOnce("core-test-once", "once");
     Logger::warningOnce("core-test-once", "once");
+    const size_t beforeReset = got.size();
+    Logger::resetWarningsOnce();  // the key is forgotten: logged once more, then silent again
+    Logger::warningOnce("core-test-once", "once again");
+    Logger::warningOnce("core-test-once", "once again");
     Logger::setSink(nullptr);
-    REQUIRE(got.size() == 3);
+    CHECK(beforeReset == 3);
+    REQUIRE(got.size() == 4);
     CHECK(got[0].second == "shown");
     CHECK(got[1].first == LogLevel::DEBUG);
     CHECK(got[2].second == "once");
+    CHECK(got[3].second == "once again");
   }
 
   TEST_CASE("property container stores typed values by name and rejects wrong types") {
