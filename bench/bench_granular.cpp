@@ -1,5 +1,5 @@
 // Particle benchmarks (GranularBodySystem):
-//   spheres10k_jitter as particles (SCENES.md: 10,000 spheres r 0.05, dt 1/100, 10 iterations, 300 steps),
+//   spheres10k_jitter as particles (docs/scenes.md: 10,000 spheres r 0.05, dt 1/100, 10 iterations, 300 steps),
 //     on 1 and 2 threads: median and mean ms/step over the whole run, and the scene's metrics at the end
 //     (max penetration in mm and in % of the radius, kinetic energy, escaped spheres);
 //   the same lattice with 100k spheres in a larger box (perRow 57, inner half width 3.145 m), first 60 steps

@@ -1,4 +1,4 @@
-// One fixture per reference scene of SCENES.md. See scene_fixture.h for the timing pattern (one iteration =
+// One fixture per reference scene of docs/scenes.md. See scene_fixture.h for the timing pattern (one iteration =
 // one step, scenes rebuilt untimed at the end of each defined run) and the metric counters (one untimed
 // complete run after the timed loop).
 #include <cmath>

@@ -3,7 +3,7 @@
 // the scene. scripts/speed_accuracy.py runs this with --benchmark_format=json and turns the output into
 // docs/speed-accuracy.md (tables, Pareto fronts, recommendation) and one PNG per scene (gnuplot).
 //
-// Scenes (SCENES.md builders) and their error:
+// Scenes (docs/scenes.md builders) and their error:
 //   chain20     released from horizontal, 5 s: largest joint separation over all joints and steps, m
 //   tower10     3 s: largest displacement of any box from its start, m (drift)
 //   pyramid20   3 s: largest displacement of any box, m

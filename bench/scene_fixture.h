@@ -1,4 +1,4 @@
-// Google Benchmark fixture base for the reference scenes (bench/scenes, SCENES.md).
+// Google Benchmark fixture base for the reference scenes (bench/scenes, docs/scenes.md).
 //
 // Timing: one benchmark iteration = one Simulation::stepForward(). Every timed step belongs to a run of the
 // defined scene: when a run reaches the scene's defined step count the scene is rebuilt from scratch with the

@@ -20,7 +20,7 @@ import sys
 # Error above which a setting no longer does the scene's job (the "usable" line of the report), with its meaning.
 USABLE = {
     "chain20": (0.01, "largest joint separation over 5 s, m; usable below 1 cm"),
-    "tower10": (0.01, "largest box displacement after 3 s, m; usable below 1 cm (SCENES.md goal)"),
+    "tower10": (0.01, "largest box displacement after 3 s, m; usable below 1 cm (docs/scenes.md goal)"),
     "pyramid20": (0.1, "largest box displacement after 3 s, m; usable below 10 cm (the stand test)"),
     "mass_ratio": (0.01, "worst overlap of the two boxes over 3 s, m (1000 = light box squeezed out); usable below 1 cm"),
     "pile1000": (0.005, "largest penetration after 2 s, m; usable below 5 mm (10 % of the radius)"),

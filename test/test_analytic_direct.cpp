@@ -1,5 +1,6 @@
 // DIRECT solver (solver/include/scree/solver/direct.h, Simulation's hybrid solve) against closed-form values and
-// against converged PGS.
+// against converged PGS. In a build without SuiteSparse the cases that need the direct solver are skipped
+// (test_build.h) and the PGS half of the chain-report case still runs.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -47,7 +48,8 @@ Real maxDepthBetween(const Simulation& sim, const RigidBody* a, const RigidBody*
 }
 }  // namespace
 
-TEST_CASE("chain20 (100:1) hanging at rest: DIRECT joint error is the joint's elastic stretch") {
+TEST_CASE("chain20 (100:1) hanging at rest: DIRECT joint error is the joint's elastic stretch" *
+          test::needsDirectSolver()) {
   // The top joint carries the whole chain: (20 x 1 kg + 100 kg) g = 1177.2 N; with the default compliance
   // 1e-8 m/N SPOOK settles it at the stretch F eps = 1.1772e-5 m (DESIGN.md §3: lambda/h = -g/eps at rest). The
   // direct solve is exact up to round-off, so the worst error over the 600 steps equals that stretch; 1 %
@@ -70,7 +72,8 @@ TEST_CASE("chain20 (100:1) hanging at rest: DIRECT joint error is the joint's el
   CHECK(pgs10.maxSeparation > 100 * direct.maxSeparation);
 }
 
-TEST_CASE("chain20 (100:1) released from horizontal: DIRECT stays connected where PGS comes apart") {
+TEST_CASE("chain20 (100:1) released from horizontal: DIRECT stays connected where PGS comes apart" *
+          test::needsDirectSolver()) {
   // The bound is the issue's 5 mm. Where it comes from with DIRECT: SPOOK's rows are linearised at the start of
   // the step, so the links drift by ~(omega h)^2 |r| / 2 per step; at dt 1/60 the light links whip under the
   // 100 kg ball faster than the step resolves and the drift reaches centimetres. The post-step projection
@@ -82,7 +85,7 @@ TEST_CASE("chain20 (100:1) released from horizontal: DIRECT stays connected wher
   const auto fine = runChain(false, FrictionModel::DIRECT, 1.0 / 600, 6000, 10);
   // Without the projection the same solve drifts by centimetres (6.5 cm): the projection is what holds it.
   const auto unprojected = runChain(false, FrictionModel::DIRECT, 1.0 / 60, 600, 10, -1, false);
-  // PGS (10 iterations) separates by metres (every engine in SCENES.md explodes here); its rows are ITERATIVE,
+  // PGS (10 iterations) separates by metres (every engine in docs/scenes.md explodes); its rows are ITERATIVE,
   // so the projection does not touch them.
   const auto pgs = runChain(false, FrictionModel::ITERATIVE, 1.0 / 60, 600, 10);
   std::printf("chain20 released: DIRECT dt 1/60 %.3e m (drift before projection up to %.3e m, unprojected "
@@ -97,7 +100,7 @@ TEST_CASE("chain20 (100:1) released from horizontal: DIRECT stays connected wher
   CHECK(pgs.maxSeparation > 5 * direct.maxSeparation);
 }
 
-TEST_CASE("the position projection leaves motion within its tolerance to SPOOK") {
+TEST_CASE("the position projection leaves motion within its tolerance to SPOOK" * test::needsDirectSolver()) {
   // A 60 degree pendulum of a 1 kg bob on a 1 m DIRECT DistanceJoint at h = 0.01 s: SPOOK's lag a_c h tau / 2
   // (a_c <= 9.8 m/s^2, tau = 2/60 s) is ~1.6 mm, inside the 2 mm tolerance, so the projection never moves it and
   // the run is bit-identical to one without the projection. With a 0.1 mm tolerance it projects every step and
@@ -142,7 +145,8 @@ TEST_CASE("a PGS chain that comes apart is reported, not silent") {
   Logger::setSink([&](LogLevel l, const std::string& msg) {
     if (l == LogLevel::ERROR) errors.push_back(msg);
   });
-  for (auto t : {FrictionModel::ITERATIVE, FrictionModel::DIRECT}) {
+  // Without the direct solver (SCREE_WITH_SUITESPARSE off) only the PGS half runs.
+  for (auto t : test::availableSolveTypes({FrictionModel::ITERATIVE, FrictionModel::DIRECT})) {
     errors.clear();
     scenes::Chain20Scene s = scenes::buildChain20(100.0, true);
     s.sim->getSolver().setNumIterations(10);
@@ -173,7 +177,8 @@ TEST_CASE("a PGS chain that comes apart is reported, not silent") {
   Logger::setSink(nullptr);
 }
 
-TEST_CASE("1000 kg box on a 1 kg box: DIRECT penetrations are the compliance-predicted ones") {
+TEST_CASE("1000 kg box on a 1 kg box: DIRECT penetrations are the compliance-predicted ones" *
+          test::needsDirectSolver()) {
   // Each interface carries the weight above it over 4 corner points with stiffness E per point (the scene's
   // contact material: two default 4e8 N/m materials in series, 2e8 N/m): at rest SPOOK settles at depth
   // F / (4 E). Upper: 1000 g / 8e8 = 1.2263e-5 m, lower: 1001 g / 8e8 = 1.2275e-5 m. After 2 s (27 damping
@@ -193,7 +198,7 @@ TEST_CASE("1000 kg box on a 1 kg box: DIRECT penetrations are the compliance-pre
   CHECK(s.sim->getSolver().getStats().numDirectRows > 0);
 }
 
-TEST_CASE("a few boxes: DIRECT and PGS with 2000 iterations agree on contact forces") {
+TEST_CASE("a few boxes: DIRECT and PGS with 2000 iterations agree on contact forces" * test::needsDirectSolver()) {
   // A 2-box stack (the top one off centre) and a box beside it. Both worlds run the same 59 steps with PGS (2000
   // sweeps, no shock propagation, which changes the solution), so they are bit-identical; the last step is
   // solved by PGS in one and by DIRECT in the other, from the same state and warm start. Compared: each contact's
@@ -243,7 +248,8 @@ TEST_CASE("a few boxes: DIRECT and PGS with 2000 iterations agree on contact for
   CHECK(worstF < 0.01);
 }
 
-TEST_CASE("a lump of spheres with infinite friction and adhesion falls and lands as one body") {
+TEST_CASE("a lump of spheres with infinite friction and adhesion falls and lands as one body" *
+          test::needsDirectSolver()) {
   // The manual's DIRECT particle mode: friction and adhesion infinite, adhesive overlap zero. Among the lump's
   // spheres every row is an equality (no bound), so while it falls each step is one factorisation and no pivot.
   // Landing (restitution 0: the impact stage stops it within a step) loads the inter-sphere springs with at
@@ -288,7 +294,7 @@ TEST_CASE("a lump of spheres with infinite friction and adhesion falls and lands
   CHECK(s[0]->getPosition().z() == doctest::Approx(r).epsilon(1e-3).scale(0));  // landed
 }
 
-TEST_CASE("the symbolic analysis is reused while the sparsity pattern holds") {
+TEST_CASE("the symbolic analysis is reused while the sparsity pattern holds" * test::needsDirectSolver()) {
   // A hanging chain keeps its rows and pattern every step: one analysis on the first step, none after.
   scenes::Chain20Scene s = scenes::buildChain20(100.0, true);
   s.step();

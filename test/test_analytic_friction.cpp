@@ -7,7 +7,7 @@
 //   incline mu 0.5 (a = g (sin30 - 0.5 cos30) = 0.6571 m/s^2): x_120 = h^2 a 120*121/2 = 1.3252 m, +0.83 %
 //     of 0.5 a t^2 = 1.3143 m.
 // A correct friction solver lands on those values; 2 % allows the discretisation floor (~1 %) plus about one
-// step of stop-time quantisation, and nothing more. Other engines measure -0.98 % and +0.83 % (SCENES.md).
+// step of stop-time quantisation, and nothing more. Other engines measure -0.98 % and +0.83 % (docs/scenes.md).
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -37,7 +37,7 @@ TEST_CASE("a box sliding at 5 m/s with mu 0.3 stops at v^2/(2 mu g) within 2 %")
 
 TEST_CASE("a cube on a 30 degree incline with mu 0.6 sticks (moves < 1 mm in 2 s)") {
   // tan 30 = 0.577 < 0.6: static friction holds. 1 mm bounds the creep a regularised (compliant) friction row
-  // may show; Jolt and ODE's direct solver creep 0.05 mm, ODE QuickStep 5.7 mm (SCENES.md).
+  // may show; Jolt and ODE's direct solver creep 0.05 mm, ODE QuickStep 5.7 mm (docs/scenes.md).
   InclineScene s = buildIncline(0.6);
   const InclineMetrics m = runIncline(s);
   MESSAGE("incline mu 0.6: displacement along the slope " << m.displacement * 1e3 << " mm");

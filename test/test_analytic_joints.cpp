@@ -2,7 +2,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
-#include <cstdio>
+#include <string>
 
 #include "test_world.h"
 
@@ -209,26 +209,58 @@ TEST_SUITE("joints") {
     CHECK(std::abs(std::abs(f[2]) - 2.0 * 9.81) < 0.02 * 2.0 * 9.81);
   }
 
-  TEST_CASE("20-link chain with a 100 kg end mass: worst joint error with PGS is recorded") {
-    // chain20 of SCENES.md (the scene's 10 iterations), hanging at rest and released from horizontal.
-    auto measure = [](bool hanging) {
-      scenes::Chain20Scene s = scenes::buildChain20(100.0, hanging);
-      for (auto& j : s.joints) j->setSolveType(FrictionModel::ITERATIVE);  // joints default to the direct solver
-      return scenes::runChain20(s);
+  TEST_CASE("chain20 with PGS: a 1 kg end mass hangs at the joints' elastic stretch, a 100 kg one comes apart "
+            "and is reported") {
+    // chain20 of docs/scenes.md (the scene's 10 iterations) with every joint ITERATIVE (joints default to
+    // DIRECT_AND_ITERATIVE).
+    struct Run {
+      scenes::ChainMetrics metrics;
+      size_t stepsReported = 0;  // steps whose StepReport listed separated joints
+      size_t errorsLogged = 0;
     };
-    const auto hanging = measure(true);
-    const auto released = measure(false);
-    std::printf("chain20 (100:1) PGS 10 iterations: hanging worst joint error %.3e m, released from horizontal "
-                "%.3e m (first > 0.1 m at %.2f s)\n",
-                hanging.maxSeparation, released.maxSeparation, released.firstAbove10cm);
-    // Recorded, not asserted: PGS at 10 iterations does not hold a 100:1 chain (every engine in SCENES.md
-    // explodes on it); the DIRECT solver issue is where it gets its bound. A 1:1 chain does hold:
-    scenes::Chain20Scene light = scenes::buildChain20(1.0, true);
-    for (auto& j : light.joints) j->setSolveType(FrictionModel::ITERATIVE);
-    const auto lightHanging = scenes::runChain20(light);
-    MESSAGE("chain20 with a 1 kg end mass, hanging: worst joint error " << lightHanging.maxSeparation << " m");
-    // Static load on the top joint: 21 kg x g x compliance 1e-8 m/N = 2e-6 m; PGS leaves at most a few times that.
-    CHECK(lightHanging.finite);
-    CHECK(lightHanging.maxSeparation < 1e-4);
+    auto run = [](Real ballMass, bool hanging) {
+      Run r;
+      Logger::setSink([&](LogLevel l, const std::string&) { r.errorsLogged += l == LogLevel::ERROR; });
+      scenes::Chain20Scene s = scenes::buildChain20(ballMass, hanging);
+      for (auto& j : s.joints) j->setSolveType(FrictionModel::ITERATIVE);
+      scenes::ChainObserver obs(s);
+      for (int i = 0; i < s.numSteps; ++i) {
+        s.sim->stepForward();
+        obs.observe();
+        r.stepsReported += !s.sim->getLastStepReport().separatedConstraints.empty();
+      }
+      Logger::setSink(nullptr);
+      r.metrics = obs.result();
+      return r;
+    };
+    // 1:1, hanging at rest: the top joint carries the 20 links and the ball, 21 kg g = 206 N, and its compliance
+    // 1e-8 m/N stretches it by 2.06e-6 m; the joints below carry less. Warm-started PGS converges at rest over the
+    // 600 steps, so the worst error is that stretch: 1 %, as for the direct solver (test_analytic_direct.cpp).
+    // Measured: equal to 4 digits.
+    const Run light = run(1.0, true);
+    const Real stretch = 21 * 9.81 * 1e-8;
+    MESSAGE("chain20 1:1 hanging, PGS: worst joint error " << light.metrics.maxSeparation << " m (stretch "
+                                                           << stretch << " m)");
+    CHECK(light.metrics.finite);
+    CHECK(light.metrics.maxSeparation == doctest::Approx(stretch).epsilon(0.01));
+    CHECK(light.stepsReported == 0);
+    CHECK(light.errorsLogged == 0);
+    // 100:1: PGS at 10 sweeps does not hold it, hanging or released (no engine in docs/scenes.md does; measured
+    // 1.9e11 m hanging, beyond 0.1 m from 0.18 s, and 10 m released, from 0.8 s). What is asserted is that it is
+    // not silent: a chain beyond the 0.1 m threshold is listed in the step report and logged, at most once per
+    // joint (measured: 21 errors, one per joint). Should PGS ever hold it, firstAbove10cm stays -1: then this
+    // case, README's status table and docs/speed-accuracy.md need updating.
+    for (bool hanging : {true, false}) {
+      CAPTURE(hanging);
+      const Run heavy = run(100.0, hanging);
+      MESSAGE("chain20 100:1 " << std::string(hanging ? "hanging" : "released") << ", PGS: worst joint error "
+                               << heavy.metrics.maxSeparation << " m, first > 0.1 m at "
+                               << heavy.metrics.firstAbove10cm << " s, " << heavy.stepsReported << " steps reported, " << heavy.errorsLogged
+                               << " errors logged");
+      CHECK(heavy.metrics.firstAbove10cm >= 0);
+      CHECK(heavy.stepsReported > 0);
+      CHECK(heavy.errorsLogged >= 1);
+      CHECK(heavy.errorsLogged <= 21);  // once per joint, not once per step
+    }
   }
 }

@@ -106,7 +106,7 @@ TEST_CASE("100 m/s impacts on the ground: finite, no energy gain, the body stays
 }
 
 // 1e5 : 1 with PGS at the scene's 10 iterations. (1e6 : 1 still squeezes the light box out with PGS at 10
-// iterations; that extreme is the DIRECT solver issue's, whose extremes suite covers it.)
+// iterations; test_extremes_solvers.cpp holds it with DIRECT contacts.)
 TEST_CASE("a 1e5 kg box on a 1 kg box: finite and bounded") {
   TestWorld w(1.0 / 60.0, kG);
   w.addGround();

@@ -1,9 +1,12 @@
 // Broadphase and Space: the uniform grid reports exactly the brute-force overlapping pairs (once each,
-// sorted), and the Space filters pairs by the documented rules and orders its contacts by geometry id.
+// sorted) with the work its cell size predicts, and the Space filters pairs by the documented rules and orders
+// its contacts by geometry id.
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
+#include <utility>
 
 #include "scree/collide/geometry.h"
 #include "scree/collide/shapes.h"
@@ -94,6 +97,7 @@ TEST_CASE("uniform grid reports exactly the brute-force pair set for several siz
         CHECK(pairs.size() == ref.size());
         CHECK(pairs == ref);  // same pairs, same (i < j) sorted order, no duplicates
         CHECK(grid.getUsedCellSize() > 0);
+        CHECK(grid.getNumCandidateTests() >= pairs.size());  // a pair is reported only after its AABB test
       }
 }
 
@@ -117,18 +121,46 @@ TEST_CASE("uniform grid picks twice the median extent and is repeatable across c
   CHECK(a == PairList{{0, 1}, {0, 2}, {1, 2}});
 }
 
-TEST_CASE("uniform grid at constant density: the pair count grows linearly with N") {
-  // Linear cost: with the automatic cell size (2 x median extent) a box of the median size covers at most
-  // 2 cells per axis, so the number of candidate tests grows linearly with N at constant density. Check it
-  // indirectly: doubling N at constant density about doubles the pair count (no quadratic blow-up).
+TEST_CASE("uniform grid at constant density: cell entries and candidate tests are the cell-size prediction") {
+  // The pair count of an input is fixed by the input (any correct broadphase, an all-pairs loop included, returns
+  // the same pairs), so it says nothing about cost. The grid's own work does. Boxes of width w = 1 m with centres
+  // uniform in (-a, a)^3 and the automatic cell size c = 2 w: along one axis a box touches cell column k with
+  // probability q_k = |(-a, a) ∩ [c k - w/2, c (k+1) + w/2)| / (2 a), so the expected number of (cell, box)
+  // entries is n (sum_k q_k)^3 (1.5^3 = 3.375 per box away from the walls), and the expected number of box pairs
+  // sharing a cell, which is what the grid tests, is C(n, 2) (sum_k q_k^2)^3: about 2.6 n at this density
+  // (0.0625 boxes per m^3) for both sizes, where an all-pairs loop would test C(n, 2) = 2000 n and 4000 n.
+  // Tolerances: entries are a sum of n independent per-box counts (sd 2.1 per box: 1 % of the mean at n = 4000),
+  // bound 3 %; tests sum ~1e4 pair events, Poisson-like (sd ~1 %), bound 5 %. Hash collisions between distinct
+  // cells would add tests; with ~2e4 occupied cells and a 32-bit hash they are expected ~0.05 times.
+  const Real w = 1.0;
   std::mt19937 rng(9);
   UniformGrid grid;
-  PairList p1, p2;
-  std::vector<Aabb> b1 = randomBoxes(rng, 4000, Sizes::UNIFORM, 20.0);
-  std::vector<Aabb> b2 = randomBoxes(rng, 8000, Sizes::UNIFORM, 20.0 * std::cbrt(2.0));
-  grid.findPairs(b1, p1);
-  grid.findPairs(b2, p2);
-  CHECK(double(p2.size()) / double(p1.size()) == doctest::Approx(2.0).epsilon(0.15));
+  PairList pairs;
+  using Size = std::pair<size_t, Real>;  // number of boxes, half-width of the region of centres
+  for (const auto& [n, a] : {Size{4000, 20.0}, Size{8000, 20.0 * std::cbrt(2.0)}}) {
+    CAPTURE(n);
+    const std::vector<Aabb> boxes = randomBoxes(rng, n, Sizes::UNIFORM, a);
+    grid.findPairs(boxes, pairs);
+    const Real c = grid.getUsedCellSize();
+    REQUIRE(c == doctest::Approx(2 * w));
+    double s1 = 0, s2 = 0;
+    for (long k = long(std::floor((-a - w / 2) / c)); Real(k) * c < a + w / 2; ++k) {
+      const double lo = std::max(-a, Real(k) * c - w / 2), hi = std::min(a, Real(k + 1) * c + w / 2);
+      if (hi <= lo) continue;
+      const double q = (hi - lo) / (2 * a);
+      s1 += q;
+      s2 += q * q;
+    }
+    const double expectedEntries = double(n) * s1 * s1 * s1;
+    const double expectedTests = 0.5 * double(n) * double(n - 1) * s2 * s2 * s2;
+    const double entries = double(grid.getNumCellEntries()), tests = double(grid.getNumCandidateTests());
+    MESSAGE("n " << n << ": cell entries " << entries << " (expected " << expectedEntries << "), candidate tests "
+                 << tests << " (expected " << expectedTests << ", all pairs " << 0.5 * double(n) * double(n - 1)
+                 << "), pairs found " << pairs.size());
+    CHECK(entries == doctest::Approx(expectedEntries).epsilon(0.03));
+    CHECK(tests == doctest::Approx(expectedTests).epsilon(0.05));
+    CHECK(tests >= double(pairs.size()));  // every reported pair was tested
+  }
 }
 
 TEST_CASE("space filters pairs: same body, groups, geometry and body pairs, collisions off, static-static") {
@@ -220,7 +252,9 @@ TEST_CASE("space contacts are ordered by geometry id with geometry 0 the lower i
   std::vector<GeometryContact> contacts;
   space.collide(1.0 / 60, contacts);
   REQUIRE(contacts.size() == 5);
-  CHECK(space.getNumBroadphasePairs() >= 5);
+  // Only neighbours overlap: centres 0.95 m apart, AABBs 1 m wide plus the 1e-3 m resting margin; next-but-one
+  // neighbours are 1.9 m apart.
+  CHECK(space.getNumBroadphasePairs() == 5);
   for (size_t k = 0; k < contacts.size(); ++k) {
     const GeometryContact& c = contacts[k];
     CHECK(c.geometry(0)->getId() < c.geometry(1)->getId());

@@ -7,6 +7,8 @@
 
 #include <scree/scree.h>
 
+#include "test_build.h"
+
 using namespace scree;
 
 TEST_SUITE("core") {
@@ -21,11 +23,17 @@ TEST_SUITE("core") {
     Logger::setLevel(LogLevel::WARNING);
     Logger::warningOnce("core-test-once", "once");
     Logger::warningOnce("core-test-once", "once");
+    const size_t beforeReset = got.size();
+    Logger::resetWarningsOnce();  // the key is forgotten: logged once more, then silent again
+    Logger::warningOnce("core-test-once", "once again");
+    Logger::warningOnce("core-test-once", "once again");
     Logger::setSink(nullptr);
-    REQUIRE(got.size() == 3);
+    CHECK(beforeReset == 3);
+    REQUIRE(got.size() == 4);
     CHECK(got[0].second == "shown");
     CHECK(got[1].first == LogLevel::DEBUG);
     CHECK(got[2].second == "once");
+    CHECK(got[3].second == "once again");
   }
 
   TEST_CASE("property container stores typed values by name and rejects wrong types") {
@@ -55,6 +63,12 @@ TEST_SUITE("core") {
     setAssertHandler(old);
     CHECK(calls == 1);
     CHECK(std::string(getConfigurationString()).find("Scree") == 0);
+  }
+
+  TEST_CASE("the configuration string and the compile definition agree on the direct solver") {
+    // Tests pick DIRECT cases by the compile definition (test_build.h); the runtime string must say the same.
+    const std::string config = getConfigurationString();
+    CHECK(config.find(test::kHasDirectSolver ? "SuiteSparse on" : "SuiteSparse off") != std::string::npos);
   }
 
   TEST_CASE("materials combine as springs in series, geometric means and sums") {

@@ -34,7 +34,7 @@ TEST_SUITE("granular") {
     m->setDensity(2500);
     g.setMaterial(m);
     const size_t id = g.createParticle(Vec3(1, 2, 3), 0.05, Vec3(0, 0, -1));
-    // 2500 * 4/3 pi 0.05^3 = 1.30899694 kg (SCENES.md spheres10k quotes 1.309 kg); only round-off differs.
+    // 2500 * 4/3 pi 0.05^3 = 1.30899694 kg (docs/scenes.md spheres10k quotes 1.309 kg); only round-off differs.
     CHECK(g.getMass(id) == doctest::Approx(2500 * 4.0 / 3.0 * std::numbers::pi * 0.125e-3).epsilon(1e-14));
     CHECK(g.getPosition(id) == Vec3(1, 2, 3));
     CHECK(g.getVelocity(id) == Vec3(0, 0, -1));

@@ -10,6 +10,7 @@
 #include <scree/scree.h>
 
 #include "scenes/scenes.h"
+#include "test_build.h"
 
 namespace scree::test {
 

@@ -4,7 +4,7 @@
 //
 // Built only when pkg-config finds `bullet-float64` (Debian: apt-get install libbullet-dev); nothing else in
 // Scree depends on Bullet. Both engines start from the same 10,000 positions (taken from Scree's scene builder,
-// SCENES.md lattice with splitmix64 jitter), same radius, mass, inertia 0.4 m r^2, mu 0.5, restitution 0,
+// docs/scenes.md lattice with splitmix64 jitter), same radius, mass, inertia 0.4 m r^2, mu 0.5, restitution 0,
 // ground box top at z = 0 and four 0.2 m walls with inner faces at +-1 m, dt 1/100, 300 steps. Each benchmark
 // iteration is one complete run; per-step times come from a clock around the step call, and the counters give
 // the median and mean ms/step. Bullet's final state is written into the Scree scene's particle arrays so that

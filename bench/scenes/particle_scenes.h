@@ -16,7 +16,7 @@ struct ParticleScene : Scene {
   const GranularBodySystem& particles() const { return sim->getGranularBodySystem(); }
 };
 
-/// SCENES.md spheres10k(_jitter) lattice with particles: same ground, walls, material (density, explicit
+/// docs/scenes.md spheres10k(_jitter) lattice with particles: same ground, walls, material (density, explicit
 /// contact material with mu and restitution 0), dt and positions as buildSphereLattice. perRow and count
 /// may be scaled (a larger box: perRow * spacing / 2 + 0.01 is the inner half width).
 ParticleScene buildParticleLattice(const SphereLatticeParams& p);

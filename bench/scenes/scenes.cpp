@@ -1,4 +1,4 @@
-// Reference scene builders and metrics; see scenes.h and SCENES.md.
+// Reference scene builders and metrics; see scenes.h and docs/scenes.md.
 #include "scenes/scenes.h"
 
 #include <algorithm>
@@ -42,7 +42,7 @@ void initScene(Scene& s, const std::string& name, Real mu, Real dt, int numSteps
   s.sim->getSolver().setNumIterations(SceneConstants::solverIterations);
 
   // One scene material carried by every geometry, with the scene's mu and restitution 0, and an explicit
-  // contact material (mat, mat) so the effective coefficient is exactly mu (SCENES.md).
+  // contact material (mat, mat) so the effective coefficient is exactly mu (docs/scenes.md).
   s.material = std::make_shared<Material>(name);
   s.material->setFrictionCoefficient(mu);
   s.material->setRestitution(0.0);

@@ -1,5 +1,5 @@
-// Reference scenes (docs: /work/shared/SCENES.md) and their accuracy metrics, shared by the benchmarks
-// (bench/bench_*.cpp), the tests (test/) and the examples. Every builder follows SCENES.md to the letter:
+// Reference scenes (defined in docs/scenes.md) and their accuracy metrics, shared by the benchmarks
+// (bench/bench_*.cpp), the tests (test/) and the examples. Every builder follows docs/scenes.md to the letter:
 //   z up, gravity (0, 0, -9.81), restitution 0, no damping, one scene Material carried by every body (static
 //   ones included) with the scene's friction coefficient, and an explicit contact material (mat, mat) with
 //   friction mu and restitution 0. The ground is a static box 100 x 100 x 1 m with its top face at z = 0.
@@ -22,7 +22,7 @@
 
 namespace scree::scenes {
 
-/// SCENES.md common values.
+/// docs/scenes.md common values.
 struct SceneConstants {
   static constexpr Real gravity = 9.81;           ///< m/s^2, along -z
   static constexpr int solverIterations = 10;
@@ -49,7 +49,7 @@ struct Scene {
 /// A scene's common setup: Simulation with dt, gravity (0,0,-9.81), 10 iterations, scene material with mu
 /// and restitution 0, explicit contact material. Exposed for tests that build variants.
 void initScene(Scene& s, const std::string& name, Real mu, Real dt, int numSteps);
-/// Adds the SCENES.md ground (static box 100 x 100 x 1, top face at z = 0) to `s`.
+/// Adds the docs/scenes.md ground (static box 100 x 100 x 1, top face at z = 0) to `s`.
 RigidBodyRef addGround(Scene& s);
 /// A static box body carrying the scene material.
 RigidBodyRef addStaticBox(Scene& s, const Vec3& halfExtents, const Vec3& position,
@@ -224,7 +224,7 @@ struct SpheresScene : Scene {
   std::vector<RigidBodyRef> walls;  ///< +x, -x, +y, -y
   Real wallInner = 1.0;             ///< m, inner faces at x = +-wallInner and y = +-wallInner
 };
-/// SCENES.md lattice: x, y = (i - (perRow/2 - 0.5)) * spacing, z = radius + 0.01 + spacing * k, filled layer
+/// docs/scenes.md lattice: x, y = (i - (perRow/2 - 0.5)) * spacing, z = radius + 0.01 + spacing * k, filled layer
 /// by layer, within a layer row by row (j along y outer, i along x inner). With perRow = 18 the walls' inner
 /// faces sit at +-(perRow * spacing / 2 + 0.01) = +-1 m.
 SpheresScene buildSphereLattice(const SphereLatticeParams& p);
@@ -276,7 +276,7 @@ std::vector<Vec3> boxCorners(const RigidBody& body, const Vec3& halfExtents);
 // 7. chain20: pivot at (0, 0, 5), 20 box links (0.2 x 0.05 x 0.05 m, 1 kg) laid along +x and joined end to end
 // by ball joints, a 100 kg sphere (r = 0.2) on a ball joint 0.2 m beyond the last link; collisions off;
 // released from rest; dt 1/60, 600 steps. `hanging` builds the same chain hanging straight down at rest
-// (a static-load check; not part of SCENES.md).
+// (a static-load check; not part of docs/scenes.md).
 struct Chain20Scene : Scene {
   std::vector<RigidBodyRef> links;
   RigidBodyRef ball;

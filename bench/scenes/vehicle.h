@@ -1,5 +1,5 @@
 // Four-wheeled vehicle on TwoBodyTireModel tires (issue 6), shared by the tire tests, bench/bench_tire.cpp
-// and the demo. Not one of SCENES.md's reference scenes; it uses the scene conventions (z up, g 9.81, one
+// and the demo. Not one of docs/scenes.md's reference scenes; it uses the scene conventions (z up, g 9.81, one
 // scene material, explicit contact material).
 //
 // chassis (box) --Hinge with Motor1D, axle y--> rim (mass only) --TwoBodyTireModel--> tire (Cylinder, axis y)

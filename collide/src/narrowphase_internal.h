@@ -79,7 +79,8 @@ void makeBoxPolytope(const Vec3& halfExtents, const Transform& t, Polytope& out)
 void makeConvexPolytope(const Convex& c, const Transform& t, Polytope& out);
 
 /// SAT over face normals and edge-pair axes, then reference/incident face clipping (or the closest points of the
-/// two supporting edges). Normal from B towards A. `idSalt` is mixed into feature ids. Appends at most 4 points.
+/// two supporting edges). Normal from B towards A. Feature ids come from the face (or edge) indices and the clip
+/// labels, so a resting pair keeps them from step to step. Appends at most 4 points.
 int collidePolytopes(const Polytope& a, const Polytope& b, Real margin, std::vector<ContactPoint>& out);
 
 // --- clipping shared by box-box and polytopes ----------------------------------------------------------------

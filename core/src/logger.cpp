@@ -53,4 +53,9 @@ void Logger::warningOnce(const std::string& key, const std::string& message) {
   warning(message);
 }
 
+void Logger::resetWarningsOnce() {
+  std::lock_guard<std::mutex> lock(state().mutex);
+  state().onceKeys.clear();
+}
+
 }  // namespace scree

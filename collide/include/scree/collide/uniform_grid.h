@@ -28,10 +28,18 @@ class UniformGrid {
   /// All pairs (i, j), i < j, whose boxes overlap, sorted. Boxes with lo > hi (empty) are skipped.
   void findPairs(const std::vector<Aabb>& boxes, std::vector<std::pair<uint32_t, uint32_t>>& outPairs);
 
+  /// Work done by the last findPairs() (read-only, for tests and profiling). Cell entries: (cell, box) entries
+  /// binned, after dropping a box's repeats within one hash bucket. Candidate tests: box pairs tested by AABB,
+  /// i.e. pairs sharing a bucket plus every oversize box against the binned and the other oversize boxes.
+  size_t getNumCellEntries() const { return numCellEntries_; }
+  size_t getNumCandidateTests() const { return numCandidateTests_; }
+
  private:
   Real cellSize_ = 0;
   Real usedCellSize_ = 0;
   Real oversizeFactor_ = 8;
+  size_t numCellEntries_ = 0;
+  size_t numCandidateTests_ = 0;
   // Scratch kept between calls (no per-step allocation once warm).
   std::vector<uint64_t> cellKeys_;
   std::vector<uint32_t> cellItems_;

@@ -27,6 +27,9 @@ class Logger {
 
   /// Logs `message` at WARNING the first time `key` is seen in this process (for "once" warnings).
   static void warningOnce(const std::string& key, const std::string& message);
+  /// Forgets the keys warningOnce has seen, so each of its warnings is logged once more (for tests that count
+  /// them, and hosts that restart their simulations).
+  static void resetWarningsOnce();
 };
 
 }  // namespace scree
