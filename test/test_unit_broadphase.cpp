@@ -12,6 +12,7 @@
 #include "scree/core/rigid_body.h"
 
 using namespace scree;
+using scree::detail::UniformGrid;
 
 namespace {
 
