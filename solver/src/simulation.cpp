@@ -189,13 +189,16 @@ void Simulation::stepForward() {
   using Clock = std::chrono::steady_clock;
   SimulationState& s = *s_;
   StepStats& t = s.stats;
-  auto timed = [](double& seconds, auto&& stage) {
-    const auto start = Clock::now();
-    stage();
-    seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  };
-  const auto start = Clock::now();
   s.report = StepReport{};
+  // One clock read per stage boundary: each stage's time runs from the end of the previous one.
+  const auto start = Clock::now();
+  auto last = start;
+  auto timed = [&last](double& seconds, auto&& stage) {
+    stage();
+    const auto now = Clock::now();
+    seconds = std::chrono::duration<double>(now - last).count();
+    last = now;
+  };
   timed(t.preCollide, [&] { runStepListeners(s, StepEventListener::PRE_COLLIDE); });
   timed(t.syncGeometries, [&] { syncGeometries(s); });
   timed(t.collideGeometries, [&] { collideGeometries(s); });
@@ -217,7 +220,7 @@ void Simulation::stepForward() {
   t.collide = t.syncGeometries + t.collideGeometries + t.collideParticles + t.resolveMaterials;
   t.rows = t.applyForces + t.contactRows + t.constraintRows + t.particleRows;
   t.integrate = t.integrateMotion + t.storeResults + t.projectPositions + t.checkFinite;
-  t.total = std::chrono::duration<double>(Clock::now() - start).count();
+  t.total = std::chrono::duration<double>(last - start).count();
 }
 
 void Simulation::stepTo(Real time) {
