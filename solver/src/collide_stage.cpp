@@ -37,19 +37,25 @@ void collideGeometries(SimulationState& s) {
   s.stats.numBroadphasePairs = s.space.getNumBroadphasePairs();
 }
 
-void collideParticles(SimulationState& s) {
-  // Particles: their own grid against each other and every geometry. Destroys are deferred from here to the
-  // end of the step so that dense indices held by the contacts stay valid through the listeners.
-  GranularBodySystem& ps = s.granular;
-  s.granularStep = s.particles.active(ps);
-  if (!s.granularStep) return;
-  // Reorder at the start of a step, before any dense index is handed out for this step.
-  if (ps.size() > 0 && s.particleSteps > 0 && s.particleSteps % GranularStage::kReorderInterval == 0 &&
-      !ps.isDeferring())
-    ps.reorder(s.particleCollider.localityOrder(ps));
-  ++s.particleSteps;
-  s.particleCollider.collide(ps, s.space.getGeometries(), s.h);
-  ps.beginDeferral();
+namespace {
+/// The geometries the particles may touch: all of the space's, less those whose collision groups are disabled
+/// against one of the particle system's groups (Simulation::setEnableCollisions). Without particle groups the
+/// space's list itself (no copy).
+const std::vector<GeometryRef>& particleGeometries(SimulationState& s) {
+  const auto& groups = s.granular.getGroups();
+  if (groups.empty()) return s.space.getGeometries();
+  s.particleGeometries.clear();
+  for (const GeometryRef& g : s.space.getGeometries()) {
+    bool enabled = true;
+    for (uint32_t pg : groups)
+      for (uint32_t gg : g->getGroups()) enabled = enabled && s.space.getEnablePair(pg, gg);
+    if (enabled) s.particleGeometries.push_back(g);
+  }
+  return s.particleGeometries;
+}
+}  // namespace
+
+void describeParticleGeometrySides(SimulationState& s) {
   // What the particle rows need of each contact's geometry (they include no collide header).
   const auto& pg = s.particleCollider.getParticleGeometryContacts();
   s.particleGeometrySides.resize(pg.size());
@@ -65,6 +71,22 @@ void collideParticles(SimulationState& s) {
     }
     s.particleGeometrySides[k] = side;
   }
+}
+
+void collideParticles(SimulationState& s) {
+  // Particles: their own grid against each other and every geometry. Destroys are deferred from here to the
+  // end of the step so that dense indices held by the contacts stay valid through the listeners.
+  GranularBodySystem& ps = s.granular;
+  s.granularStep = s.particles.active(ps);
+  if (!s.granularStep) return;
+  // Reorder at the start of a step, before any dense index is handed out for this step.
+  if (ps.size() > 0 && s.particleSteps > 0 && s.particleSteps % GranularStage::kReorderInterval == 0 &&
+      !ps.isDeferring())
+    ps.reorder(s.particleCollider.localityOrder(ps));
+  ++s.particleSteps;
+  s.particleCollider.collide(ps, particleGeometries(s), s.h);
+  ps.beginDeferral();
+  describeParticleGeometrySides(s);
 }
 
 void resolveContactMaterials(SimulationState& s) {

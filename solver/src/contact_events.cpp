@@ -59,6 +59,24 @@ void runContactEvents(SimulationState& s) {
     s.contacts.erase(std::remove_if(s.contacts.begin(), s.contacts.end(),
                                     [](const GeometryContact& c) { return c.points().empty(); }),
                      s.contacts.end());
+  runParticleContactEvents(s);
+}
+
+void runParticleContactEvents(SimulationState& s) {
+  // Only listeners that asked for particle contacts (PARTICLE_CONTACT) are called: a scene without them pays
+  // one mask test per contact listener.
+  if (!s.granularStep) return;
+  auto& pp = s.particleCollider.getParticleParticleContacts();
+  auto& pg = s.particleCollider.getParticleGeometryContacts();
+  bool called = false;
+  for (auto& l : s.contactListeners)
+    if (l->getMask() & ContactEventListener::PARTICLE_CONTACT) {
+      l->particleContacts(s.time, pp, pg);
+      called = true;
+    }
+  // The rows read one geometry description per particle-geometry contact: keep it aligned if a listener
+  // changed the list (the contract says it does not; this keeps a careless listener from reading past it).
+  if (called && pg.size() != s.particleGeometrySides.size()) describeParticleGeometrySides(s);
 }
 
 }  // namespace scree::detail

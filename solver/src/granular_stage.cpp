@@ -157,7 +157,8 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     orthonormalBasis(u.n, u.t1, u.t2);
     const uint32_t a = c.a;
     const bool deadPair = !ps.isAliveDense(a) || (isPP && !ps.isAliveDense(size_t(c.b)));
-    if (deadPair) continue;  // inert unit: all gains zero
+    // Inert unit (all gains zero): a destroyed particle, or a point a listener disabled.
+    if (deadPair || !c.enabled) continue;
     u.ra = c.point - x[a];
     const PairParams& p = isPP ? ppParams[matIdx[a] * K + matIdx[size_t(c.b)]] : pgParams[pgParam[k - pp.size()]].second;
     // Relative velocity at the point at the start of the step, and effective masses.
@@ -218,15 +219,25 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     cs.rememberedImpact = ce ? ce->impact : 0.0;
     cs.adhesiveForce = p.adhF;
     cs.adhesiveOverlap = p.adhO;
-    cs.restitution = p.rest;
-    const NormalRowCoefficients nr = contactNormalRow(law, SpookCoefficients{p.a, p.upsilon, p.eN}, cs);
+    // Per-point overrides (ContactEventListener::particleContacts), as ContactPoint's for rigid contacts.
+    cs.restitution = c.restitution >= 0 ? c.restitution : p.rest;
+    const bool ownSpook = c.youngsModulus > 0 || c.damping >= 0;
+    const SpookCoefficients spook =
+        ownSpook ? contactSpook(h, c.youngsModulus > 0 ? c.youngsModulus : p.youngsModulus,
+                                c.damping >= 0 ? c.damping : p.damping)
+                 : SpookCoefficients{p.a, p.upsilon, p.eN};
+    const NormalRowCoefficients nr = contactNormalRow(law, spook, cs);
     u.rhsN = nr.rhs;
     u.eN = nr.e;
     u.loN = nr.lo;
     u.impact = nr.impactSpeed;
     u.solveType = p.solveType;
     u.kN = 1.0 / (kn + u.eN);
-    u.mu = p.mu;
+    u.mu = c.frictionCoefficient >= 0 ? c.frictionCoefficient : p.mu;
+    if (!c.surfaceVelocity.isZero(0)) {
+      u.rhsT1 = c.surfaceVelocity.dot(u.t1);
+      u.rhsT2 = c.surfaceVelocity.dot(u.t2);
+    }
     u.eT = p.eT;
     u.kT1 = 1.0 / (kt1 + u.eT);
     u.kT2 = 1.0 / (kt2 + u.eT);
@@ -368,8 +379,8 @@ void GranularStage::solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& 
   // Friction: scalar updates of both tangents at the same velocity, then projection onto the disc.
   if (u.mu > 0) {
     const Vec3 vr = relVel();
-    Real l1 = u.lT1 + (-u.t1.dot(vr) - u.eT * u.lT1) * gain(u.kT1, u.t1, u.eT);
-    Real l2 = u.lT2 + (-u.t2.dot(vr) - u.eT * u.lT2) * gain(u.kT2, u.t2, u.eT);
+    Real l1 = u.lT1 + (u.rhsT1 - u.t1.dot(vr) - u.eT * u.lT1) * gain(u.kT1, u.t1, u.eT);
+    Real l2 = u.lT2 + (u.rhsT2 - u.t2.dot(vr) - u.eT * u.lT2) * gain(u.kT2, u.t2, u.eT);
     projectOntoDisc(l1, l2, frictionLimit(u.mu, u.lN));
     const Real d1 = l1 - u.lT1, d2 = l2 - u.lT2;
     u.lT1 = l1;
@@ -495,13 +506,7 @@ void GranularStage::appendDirectRows(const GranularBodySystem& ps, std::vector<C
     directRow_.push_back(uint32_t(normal));
     // Same rows as solveUnit: impulse P along +d on a, -d on b (or the body); J v = relative velocity along d.
     auto linear = [&](const Vec3& d) {
-      ConstraintRow r;
-      r.bodyA = ia;
-      r.bodyB = ib;
-      r.jLinA = d;
-      r.jAngA = u.ra.cross(d);
-      r.jLinB = -d;
-      r.jAngB = -u.rb.cross(d);
+      ConstraintRow r = pointRow(ia, ib, u.ra, u.rb, d);
       r.solveType = type;
       return r;
     };
@@ -514,6 +519,7 @@ void GranularStage::appendDirectRows(const GranularBodySystem& ps, std::vector<C
     if (u.mu > 0) {
       for (int j = 0; j < 2; ++j) {
         ConstraintRow f = linear(j == 0 ? u.t1 : u.t2);
+        f.rhs = j == 0 ? u.rhsT1 : u.rhsT2;
         f.e = u.eT;
         f.mu = u.mu;  // infinite: unbounded
         f.normalRow = normal;

@@ -139,6 +139,7 @@ class GranularStage {
     Vec3 ra = Vec3::Zero(), rb = Vec3::Zero();  // contact point relative to a's centre and b's centre / body's cm
     Real kN = 0, kT1 = 0, kT2 = 0, kR = 0;     // 1 / (J M^-1 J^T + e) of normal, tangents, rolling
     Real rhsN = 0, eN = 0, loN = 0, eT = 0, mu = 0, rollMu = 0;
+    Real rhsT1 = 0, rhsT2 = 0;  // friction targets: the surface velocity along t1, t2 (0 unless overridden)
     Real lN = 0, lT1 = 0, lT2 = 0, lR1 = 0, lR2 = 0;
     Real impact = 0;      // approach speed of a speculative stop this step, remembered for next step's bounce
     bool flip = false;    // a's slot is the higher one of the pair (warm-start vectors are stored for the lower)

@@ -217,6 +217,7 @@ void Simulation::stepForward() {
   timed(t.checkFinite, [&] { checkFinite(s); });
   s.time += s.h;
   timed(t.post, [&] { runStepListeners(s, StepEventListener::POST_STEP); });
+  timed(t.compactParticles, [&] { endParticleDeferral(s); });
   t.collide = t.syncGeometries + t.collideGeometries + t.collideParticles + t.resolveMaterials;
   t.rows = t.applyForces + t.contactRows + t.constraintRows + t.particleRows;
   t.integrate = t.integrateMotion + t.storeResults + t.projectPositions + t.checkFinite;

@@ -44,6 +44,7 @@ struct SimulationState {
   ParticleCollider particleCollider;
   uint64_t particleSteps = 0;             // steps with particles, for the periodic locality reorder
   std::vector<ParticleGeometrySide> particleGeometrySides;  // per particle-geometry contact, for the rows
+  std::vector<GeometryRef> particleGeometries;  // geometries the particles may touch, when they have groups
   bool granularStep = false;              // the particle system is in this step (its destroys are deferred)
 
   // ---- contact events --------------------------------------------------------------------------------------

@@ -18,6 +18,7 @@
 //   projectPositions          position_projection.cpp
 //   checkFinite               finiteness.cpp      non-finite bodies restored and stopped
 //   listeners (POST_STEP)     step_listeners.cpp
+//   endParticleDeferral       step_listeners.cpp  particle destroys deferred since collision applied
 #pragma once
 
 #include "simulation_state.h"
@@ -30,6 +31,9 @@ void collideGeometries(SimulationState& s);
 void collideParticles(SimulationState& s);
 void resolveContactMaterials(SimulationState& s);
 void runContactEvents(SimulationState& s);
+/// The particle part of the contact events stage (ContactEventListener::particleContacts); run by
+/// runContactEvents after the geometry events.
+void runParticleContactEvents(SimulationState& s);
 void applyForces(SimulationState& s);
 void buildContactRows(SimulationState& s);
 void buildConstraintRows(SimulationState& s);
@@ -39,8 +43,11 @@ void integrateMotion(SimulationState& s);
 void storeResults(SimulationState& s);
 void projectPositions(SimulationState& s);
 void checkFinite(SimulationState& s);
+void endParticleDeferral(SimulationState& s);
 
 // Helpers shared by stages.
+/// s.particleGeometrySides from the particle-geometry contact list (collide_stage.cpp).
+void describeParticleGeometrySides(SimulationState& s);
 /// Support levels and the shock-propagation order of the rows (shock_order.cpp).
 void buildShockOrder(SimulationState& s);
 /// s.geomK[b] = sum over direct-set rows on body b of |lambda / h| |r|; false when all are zero

@@ -1,6 +1,5 @@
 // Store-results stage: the solved impulses become the contact points' forces and next step's warm start, the
-// constraints' results (Constraint::storeResult) and the particle contacts' forces; the particle system's
-// deferred destroys are applied.
+// constraints' results (Constraint::storeResult) and the particle contacts' forces.
 #include "step_stages.h"
 
 namespace scree::detail {
@@ -28,7 +27,6 @@ void storeResults(SimulationState& s) {
                                      &s.particleCollider.getParticleGeometryContacts(), &s.particleGeometrySides,
                                      s.particleCollider.getCellSize()};
     s.particles.storeResults(s.granular, lists, s.h);
-    s.granular.endDeferral();
   }
 }
 

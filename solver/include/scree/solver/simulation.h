@@ -3,7 +3,9 @@
 //   PRE_COLLIDE listeners; collision (geometries synced with the space, Space broadphase + narrowphase,
 //   particle collision, contact materials resolved); contact listeners; PRE_STEP listeners; forces (free
 //   velocities); rows (contacts, constraints, particles); solve (PGS, DIRECT or hybrid, particle sweeps);
-//   integration; results stored; position projection; finiteness check; POST_STEP listeners.
+//   integration; results stored; position projection; finiteness check; POST_STEP listeners; particle
+//   destroys deferred since collision applied (so listeners, post included, may create and destroy particles
+//   while reading this step's particle contacts).
 // No exceptions inside stepForward: a body whose state turns non-finite is reported (getLastStepReport(),
 // logged as an error naming the body), restored to its last finite state and stopped.
 #pragma once
@@ -54,6 +56,7 @@ struct StepStats {
   double checkFinite = 0;        ///< s, non-finite bodies restored and stopped
   double integrate = 0;          ///< s, integrateMotion + storeResults + projectPositions + checkFinite
   double post = 0;               ///< s, POST_STEP step listeners
+  double compactParticles = 0;   ///< s, particle destroys deferred during the step applied (after post)
   double total = 0;              ///< s, the whole step
   size_t numBroadphasePairs = 0;
   size_t numContacts = 0;
