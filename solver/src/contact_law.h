@@ -99,9 +99,12 @@ inline ConstraintRow pointRow(int32_t bodyA, int32_t bodyB, const Vec3& ra, cons
 
 /// Scales the pair (l1, l2) radially onto the disc of radius lim when it lies outside: projected-cone friction
 /// (lim = mu lambda_n) and the rolling-resistance disc, in the PGS sweeps and the particle sweeps.
+/// The test is on squares so that the square root is paid only when projecting (the particle sweeps call this
+/// twice per contact and sweep).
 inline void projectOntoDisc(Real& l1, Real& l2, Real lim) {
-  const Real mag = std::sqrt(l1 * l1 + l2 * l2);
-  if (mag > lim) {
+  const Real mag2 = l1 * l1 + l2 * l2;
+  if (mag2 > lim * lim) {
+    const Real mag = std::sqrt(mag2);
     const Real s = mag > 0 ? lim / mag : 0;
     l1 *= s;
     l2 *= s;
