@@ -119,14 +119,17 @@ class Simulation {
   /// The particles of this simulation (AGX: agx::GranularBodySystem).
   GranularBodySystem& getGranularBodySystem();
   const GranularBodySystem& getGranularBodySystem() const;
-  /// Disable/enable collisions between two collision groups (see Geometry::addGroup).
+  /// Disable/enable collisions between two collision groups (see Geometry::addGroup; particles:
+  /// GranularBodySystem::addGroup).
   void setEnableCollisions(uint32_t group1, uint32_t group2, bool enable);
   void setEnableCollisions(const std::string& group1, const std::string& group2, bool enable);
 
   /// Contacts of the last step, with the forces the solver applied (sensor contacts included, no force).
   const std::vector<GeometryContact>& getContacts() const;
   /// Particle contacts of the last step with their forces (dense particle indices of that step, see
-  /// ParticleContact): particle-particle, and particle-geometry (sensor contacts included, flagged).
+  /// ParticleContact): particle-particle, and particle-geometry (sensor contacts included, flagged). The
+  /// indices stay valid through the step's listeners, POST_STEP included (destroys are deferred until after
+  /// it); after the step they name that step's arrays, which a destroy may since have compacted.
   const std::vector<ParticleContact>& getParticleParticleContacts() const;
   const std::vector<ParticleContact>& getParticleGeometryContacts() const;
   const StepStats& getStepStats() const;
