@@ -47,7 +47,7 @@ void BM_vehicle(benchmark::State& state) {
     ++steps;
   }
   state.counters["ms_per_step"] = benchmark::Counter(seconds * 1e3, benchmark::Counter::kAvgIterations);
-  state.counters["rows"] = double(scene->sim->getSolver().stats().numRows);
+  state.counters["rows"] = double(scene->sim->getSolver().getStats().numRows);
   state.counters["finite"] = scenes::allFinite(*scene->sim) ? 1.0 : 0.0;
   if (!rigid) {
     VehicleParams sp;  // parked: motors hold

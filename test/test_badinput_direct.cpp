@@ -14,6 +14,9 @@
 
 using namespace scree;
 using namespace scree::test;
+using scree::detail::ConstraintRow;
+using scree::detail::DirectSolver;
+using scree::detail::SolverBodyState;
 
 TEST_CASE("Solver: pivot cap and hybrid rounds must be >= 1") {
   Solver s;

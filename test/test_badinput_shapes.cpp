@@ -18,6 +18,7 @@
 
 using namespace scree;
 using namespace scree::test;
+using scree::detail::UniformGrid;
 
 namespace {
 

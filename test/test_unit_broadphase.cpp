@@ -15,6 +15,7 @@
 #include "scree/core/rigid_body.h"
 
 using namespace scree;
+using scree::detail::UniformGrid;
 
 namespace {
 

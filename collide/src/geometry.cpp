@@ -5,8 +5,8 @@
 //   pose, i.e. they set the local transform to body^-1 * world. Without a body they equal the local setters.
 // - setLocalPosition/setLocalRotation/setMaterial on an attached geometry recompute the body's mass
 //   properties at once (the mass depends on the placement and the density).
-// - Group names map to ids starting at 1 << 30, so named groups never collide with the small numeric ids
-//   users typically pick for addGroup(uint32_t).
+// - Group names map to ids starting at 1 << 30 (scree/core/collision_groups.h, shared with particles), so
+//   named groups never collide with the small numeric ids users typically pick for addGroup(uint32_t).
 #include "scree/collide/geometry.h"
 
 #include <algorithm>
@@ -15,6 +15,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "scree/core/collision_groups.h"
 #include "scree/core/errors.h"
 
 namespace scree {
@@ -22,16 +23,6 @@ namespace scree {
 namespace {
 
 std::atomic<uint32_t> g_nextGeometryId{1};
-
-struct GroupRegistry {
-  std::mutex mutex;
-  std::unordered_map<std::string, uint32_t> ids;
-  uint32_t next = uint32_t(1) << 30;
-};
-GroupRegistry& groupRegistry() {
-  static GroupRegistry r;
-  return r;
-}
 
 }  // namespace
 
@@ -116,11 +107,7 @@ bool Geometry::hasGroup(uint32_t id) const { return std::find(groups_.begin(), g
 
 uint32_t Geometry::groupId(const std::string& name) {
   if (name.empty()) detail::throwInvalid("Geometry::groupId", "name", name, "must not be empty");
-  GroupRegistry& r = groupRegistry();
-  std::lock_guard<std::mutex> lock(r.mutex);
-  auto [it, inserted] = r.ids.try_emplace(name, r.next);
-  if (inserted) ++r.next;
-  return it->second;
+  return detail::collisionGroupId(name);
 }
 
 }  // namespace scree

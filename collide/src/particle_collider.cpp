@@ -11,7 +11,7 @@
 #include <omp.h>
 #endif
 
-namespace scree {
+namespace scree::detail {
 
 namespace {
 // Particles per work chunk. Chunks, not threads, own output buffers: the merged order is independent of the
@@ -264,4 +264,4 @@ std::vector<uint32_t> ParticleCollider::localityOrder(const GranularBodySystem& 
   return order;
 }
 
-}  // namespace scree
+}  // namespace scree::detail

@@ -21,7 +21,7 @@
 
 #include "scree/core/errors.h"
 
-namespace scree {
+namespace scree::detail {
 
 namespace {
 
@@ -172,4 +172,4 @@ void UniformGrid::findPairs(const std::vector<Aabb>& boxes, std::vector<std::pai
   for (uint64_t k : pairKeys_) outPairs.emplace_back(uint32_t(k >> 32), uint32_t(k));
 }
 
-}  // namespace scree
+}  // namespace scree::detail

@@ -6,6 +6,7 @@
 #include <type_traits>
 #include <stdexcept>
 
+#include "scree/core/collision_groups.h"
 #include "scree/core/errors.h"
 
 namespace scree {
@@ -338,6 +339,37 @@ void GranularBodySystem::reorder(const std::vector<uint32_t>& newOrder) {
   for (auto& b : customReal_) permute(b.second);
   for (size_t k = 0; k < n; ++k) slots_[denseToSlot_[k]].dense = uint32_t(k);
   ++revision_;
+}
+
+// ---- collision groups ----------------------------------------------------------------------------------------
+
+namespace {
+uint32_t namedGroup(const char* where, const std::string& name) {
+  if (name.empty()) detail::throwInvalid(where, "name", name, "must not be empty");
+  return detail::collisionGroupId(name);
+}
+}  // namespace
+
+void GranularBodySystem::addGroup(uint32_t id) {
+  if (!hasGroup(id)) groups_.push_back(id);
+}
+void GranularBodySystem::addGroup(const std::string& name) {
+  addGroup(namedGroup("GranularBodySystem::addGroup", name));
+}
+bool GranularBodySystem::removeGroup(uint32_t id) {
+  auto it = std::find(groups_.begin(), groups_.end(), id);
+  if (it == groups_.end()) return false;
+  groups_.erase(it);
+  return true;
+}
+bool GranularBodySystem::removeGroup(const std::string& name) {
+  return removeGroup(namedGroup("GranularBodySystem::removeGroup", name));
+}
+bool GranularBodySystem::hasGroup(uint32_t id) const {
+  return std::find(groups_.begin(), groups_.end(), id) != groups_.end();
+}
+bool GranularBodySystem::hasGroup(const std::string& name) const {
+  return hasGroup(namedGroup("GranularBodySystem::hasGroup", name));
 }
 
 }  // namespace scree

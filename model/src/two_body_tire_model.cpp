@@ -7,6 +7,8 @@
 
 namespace scree {
 
+using detail::ConstraintRow;  // the solver row type (scree/solver/constraint_row.h)
+
 namespace {
 constexpr const char* kCtor = "TwoBodyTireModel::TwoBodyTireModel";
 

@@ -4,6 +4,8 @@
 
 namespace scree {
 
+using detail::ConstraintRow;  // the solver row type (scree/solver/constraint_row.h)
+
 Constraint::Constraint(RigidBodyRef a, RigidBodyRef b, int numDofs, const char* typeName)
     : a_(std::move(a)), b_(std::move(b)), typeName_(typeName) {
   const std::string where = std::string(typeName) + "::" + typeName;

@@ -9,7 +9,7 @@
 #include <cholmod.h>
 #endif
 
-namespace scree {
+namespace scree::detail {
 
 namespace {
 constexpr Real kInf = 1e299;  // |bound| beyond this is unbounded (rows use +-1e300)
@@ -516,4 +516,4 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>&, const std:
 
 #endif
 
-}  // namespace scree
+}  // namespace scree::detail

@@ -5,8 +5,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "rolling_radius.h"
-#include "scree/collide/shapes.h"
+#include "contact_law.h"
 #include "scree/solver/direct.h"
 #include "scree/solver/spook.h"
 
@@ -20,30 +19,16 @@ constexpr int kMaxSlabs = 64;
 
 uint64_t slotKey(size_t id) { return uint64_t(uint32_t(id & 0xffffffffu)); }
 
-// Scales the pair (l1, l2) onto the disc of radius lim when it lies outside (projected-cone friction and the
-// rolling-resistance disc).
-inline void projectOntoDisc(Real& l1, Real& l2, Real lim) {
-  const Real mag2 = l1 * l1 + l2 * l2;
-  if (mag2 > lim * lim) {
-    const Real s = lim / std::sqrt(mag2);
-    l1 *= s;
-    l2 *= s;
-  }
-}
+}  // namespace
 
-// Contact parameters resolved once per material pair per step.
-struct PairParams {
-  Real eN = 0, a = 0, upsilon = 1;  // SPOOK normal row
-  Real eT = 0;                      // friction-row regularisation
-  Real mu = 0, rest = 0, rolling = 0, adhF = 0, adhO = 0;
-  uint8_t solveType = FrictionModel::ITERATIVE;  // ITERATIVE, or DIRECT mode (see granular_stage.h)
-};
-PairParams makeParams(const SurfaceParameters& s, const FrictionModel* fm, Real h) {
+GranularStage::PairParams GranularStage::makeParams(const SurfaceParameters& s, const FrictionModel* fm, Real h) {
   PairParams p;
   // Without SuiteSparse every unit stays iterative (Simulation logs the one-time warning for rigid rows).
   if (fm && fm->getSolveType() != FrictionModel::ITERATIVE && DirectSolver::available())
     p.solveType = uint8_t(fm->getSolveType());
-  const SpookCoefficients co = spookHolonomic(h, 1.0 / s.getYoungsModulus(), s.getDamping());
+  p.youngsModulus = s.getYoungsModulus();
+  p.damping = s.getDamping();
+  const SpookCoefficients co = contactSpook(h, p.youngsModulus, p.damping);
   p.eN = co.e;
   p.a = co.a;
   p.upsilon = co.upsilon;
@@ -55,7 +40,6 @@ PairParams makeParams(const SurfaceParameters& s, const FrictionModel* fm, Real 
   p.adhO = s.getAdhesiveOverlap();
   return p;
 }
-}  // namespace
 
 const GranularStage::CacheEntry* GranularStage::find(const std::vector<CacheEntry>& cache, uint64_t key,
                                                      uint32_t feature) const {
@@ -65,23 +49,29 @@ const GranularStage::CacheEntry* GranularStage::find(const std::vector<CacheEntr
   return nullptr;
 }
 
-void GranularStage::collide(GranularBodySystem& ps, const std::vector<GeometryRef>& geometries, Real h) {
-  // Reorder at the start of a step, before any dense index is handed out for this step.
-  if (ps.size() > 0 && stepCount_ > 0 && stepCount_ % kReorderInterval == 0 && !ps.isDeferring())
-    ps.reorder(collider_.localityOrder(ps));
-  ++stepCount_;
-  collider_.collide(ps, geometries, h);
+void GranularStage::applyForces(GranularBodySystem& ps, const Vec3& gravity, Real h) {
+  const size_t n = ps.size();
+  auto& v = ps.velocities();
+  const auto& invM = ps.invMasses();
+  vStart_.resize(n);
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+  for (size_t i = 0; i < n; ++i) {
+    vStart_[i] = v[i];
+    if (invM[i] > 0) v[i] += h * gravity;
+  }
 }
 
-void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& materials, const Solver& solver,
+void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists& contacts,
+                              const MaterialManager& materials, const Solver& solver,
                               std::vector<SolverBodyState>& bodies,
                               const std::function<int(const RigidBody*)>& solverIndexOf, const Vec3& gravity,
                               Real h) {
   const size_t n = ps.size();
-  auto& pp = collider_.getParticleParticleContacts();
-  auto& pg = collider_.getParticleGeometryContacts();
+  const auto& pp = *contacts.particleParticle;
+  const auto& pg = *contacts.particleGeometry;
+  const auto& sides = *contacts.geometrySides;
   const auto& x = ps.positions();
-  auto& v = ps.velocities();
+  const auto& v = vStart_;  // the rows see the start-of-step velocities
   auto& w = ps.angularVelocities();
   const auto& r = ps.radii();
   const auto& invM = ps.invMasses();
@@ -96,7 +86,8 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
 
   // ---- material pairs ----------------------------------------------------------------------------------------
   const size_t K = matTable.size();
-  std::vector<PairParams> ppParams(K * K);
+  auto& ppParams = ppParams_;
+  ppParams.resize(K * K);
   for (size_t i = 0; i < K; ++i)
     for (size_t j = 0; j < K; ++j) {
       SurfaceParameters s;
@@ -105,10 +96,14 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
       ppParams[i * K + j] = makeParams(s, fm, h);
     }
   // Particle-geometry: (particle material, geometry material) pairs met this step, plus body indices.
-  std::vector<std::pair<std::pair<uint32_t, const Material*>, PairParams>> pgParams;
-  std::vector<uint32_t> pgParam(pg.size());
-  std::vector<int32_t> pgBody(pg.size());
-  std::vector<uint32_t> pgUnit(pg.size());
+  auto& pgParams = pgParams_;
+  auto& pgParam = pgParam_;
+  auto& pgBody = pgBody_;
+  auto& pgUnit = pgUnit_;
+  pgParams.clear();
+  pgParam.resize(pg.size());
+  pgBody.resize(pg.size());
+  pgUnit.resize(pg.size());
   size_t numUnits = pp.size();
   {
     const Geometry* lastGeom = nullptr;
@@ -116,7 +111,7 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
     for (size_t k = 0; k < pg.size(); ++k) {
       const ParticleContact& c = pg[k];
       if (c.sensor) continue;
-      const Material* gm = c.geometry->getMaterial().get();
+      const Material* gm = sides[k].material;
       const std::pair<uint32_t, const Material*> key{matIdx[c.a], gm};
       size_t e = 0;
       while (e < pgParams.size() && pgParams[e].first != key) ++e;
@@ -129,7 +124,7 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
       pgParam[k] = uint32_t(e);
       if (c.geometry != lastGeom) {
         lastGeom = c.geometry;
-        lastBody = solverIndexOf(c.geometry->getRigidBody());
+        lastBody = solverIndexOf(sides[k].body);
       }
       pgBody[k] = lastBody;
       pgUnit[k] = uint32_t(numUnits++);
@@ -138,33 +133,9 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
 
   // ---- units -------------------------------------------------------------------------------------------------
   scratchUnits_.resize(numUnits);
-  const Real threshold = solver.getRestitutionThreshold();
-  const Real maxRecovery = solver.getMaxPenetrationRecoverySpeed();
   const bool warm = solver.getUseWarmStarting();  // the impact memory is kept either way
 
-  // Normal row from the pair parameters; vn0 is the normal relative velocity at the start of the step, vnFree
-  // after this step's gravity, remembered the approach speed of last step's speculative stop (0 if none).
-  // Speculative contacts stop an approach exactly at the surface; the approach speed is then remembered so
-  // that the next step (touching) bounces with restitution * that speed, as the rigid contacts do.
-  auto normalRow = [&](Unit& u, const PairParams& p, Real depth, Real vn0, Real vnFree, Real remembered) {
-    const Real adhF = p.adhF;
-    if (depth < 0 && adhF <= 0) {
-      u.rhsN = depth / h;  // speculative: may close the gap, no force before that
-      u.eN = 0;
-      u.loN = 0;
-      if (remembered > threshold) u.rhsN = std::max(u.rhsN, p.rest * remembered);
-      else if (vnFree * h < depth && -vnFree > threshold) u.impact = -vnFree;
-      return;
-    }
-    const Real g = (adhF > 0 ? p.adhO : 0.0) - depth;
-    Real bias = -p.a * g;
-    if (maxRecovery > 0) bias = std::min(bias, maxRecovery);
-    u.rhsN = bias + p.upsilon * vn0;
-    u.eN = p.eN;
-    u.loN = adhF > 0 ? (std::isinf(adhF) ? -1e300 : -adhF * h) : 0.0;
-    const Real approach = std::max(remembered, -vn0);
-    if (approach > threshold) u.rhsN = std::max(u.rhsN, p.rest * approach);
-  };
+  const ContactLawSettings law{h, solver.getRestitutionThreshold(), solver.getMaxPenetrationRecoverySpeed()};
   auto effMass = [](Real im, Real ii, const Vec3& r, const Vec3& d) { return im + ii * r.cross(d).squaredNorm(); };
   auto bodyEff = [](const SolverBodyState& b, const Vec3& r, const Vec3& d) {
     const Vec3 c = r.cross(d);
@@ -186,7 +157,8 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
     orthonormalBasis(u.n, u.t1, u.t2);
     const uint32_t a = c.a;
     const bool deadPair = !ps.isAliveDense(a) || (isPP && !ps.isAliveDense(size_t(c.b)));
-    if (deadPair) continue;  // inert unit: all gains zero
+    // Inert unit (all gains zero): a destroyed particle, or a point a listener disabled.
+    if (deadPair || !c.enabled) continue;
     u.ra = c.point - x[a];
     const PairParams& p = isPP ? ppParams[matIdx[a] * K + matIdx[size_t(c.b)]] : pgParams[pgParam[k - pp.size()]].second;
     // Relative velocity at the point at the start of the step, and effective masses.
@@ -206,7 +178,8 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
       kr += invInertia_[b];
       rollR = r[a] * r[b] / (r[a] + r[b]);
     } else {
-      const RigidBody* body = c.geometry->getRigidBody();
+      const ParticleGeometrySide& side = sides[k - pp.size()];
+      const RigidBody* body = side.body;
       if (u.body >= 0) {
         const SolverBodyState& sb = bodies[size_t(u.body)];
         u.rb = c.point - body->getCmPosition();
@@ -218,7 +191,7 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
         // (average of the two, the rows are solved as a disc).
         kr += 0.5 * (u.t1.dot(sb.invInertia * u.t1) + u.t2.dot(sb.invInertia * u.t2));
       }
-      const Real gr = rollingRadius(c.geometry);
+      const Real gr = side.rollingRadius;
       if (gr > 0) rollR = r[a] * gr / (r[a] + gr);
     }
     // Warm start and remembered impact speed.
@@ -232,15 +205,39 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
         sgn = u.flip ? -1.0 : 1.0;
         ce = find(ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
       } else {
-        ce = find(pgCache_, slotKey(idA) << 32 | c.geometry->getId(), c.featureId);
+        ce = find(pgCache_, slotKey(idA) << 32 | sides[k - pp.size()].geometryId, c.featureId);
       }
     }
     const Real vn0 = u.n.dot(vrel);
     const Real vnFree = vn0 + (isPP ? 0.0 : h * gravity.dot(u.n));
-    normalRow(u, p, c.depth, vn0, vnFree, ce ? ce->impact : 0.0);
+    // Speculative contacts stop an approach exactly at the surface; the approach speed is then remembered so
+    // that the next step (touching) bounces with restitution * that speed, as the rigid contacts do.
+    NormalContactState cs;
+    cs.depth = c.depth;
+    cs.vn0 = vn0;
+    cs.vnFree = vnFree;
+    cs.rememberedImpact = ce ? ce->impact : 0.0;
+    cs.adhesiveForce = p.adhF;
+    cs.adhesiveOverlap = p.adhO;
+    // Per-point overrides (ContactEventListener::particleContacts), as ContactPoint's for rigid contacts.
+    cs.restitution = c.restitution >= 0 ? c.restitution : p.rest;
+    const bool ownSpook = c.youngsModulus > 0 || c.damping >= 0;
+    const SpookCoefficients spook =
+        ownSpook ? contactSpook(h, c.youngsModulus > 0 ? c.youngsModulus : p.youngsModulus,
+                                c.damping >= 0 ? c.damping : p.damping)
+                 : SpookCoefficients{p.a, p.upsilon, p.eN};
+    const NormalRowCoefficients nr = contactNormalRow(law, spook, cs);
+    u.rhsN = nr.rhs;
+    u.eN = nr.e;
+    u.loN = nr.lo;
+    u.impact = nr.impactSpeed;
     u.solveType = p.solveType;
     u.kN = 1.0 / (kn + u.eN);
-    u.mu = p.mu;
+    u.mu = c.frictionCoefficient >= 0 ? c.frictionCoefficient : p.mu;
+    if (!c.surfaceVelocity.isZero(0)) {
+      u.rhsT1 = c.surfaceVelocity.dot(u.t1);
+      u.rhsT2 = c.surfaceVelocity.dot(u.t2);
+    }
     u.eT = p.eT;
     u.kT1 = 1.0 / (kt1 + u.eT);
     u.kT2 = 1.0 / (kt2 + u.eT);
@@ -255,15 +252,10 @@ void GranularStage::buildRows(GranularBodySystem& ps, const MaterialManager& mat
     }
   }
 
-  partition(ps);
-
-  // Free velocities.
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (size_t i = 0; i < n; ++i)
-    if (invM[i] > 0) v[i] += h * gravity;
+  partition(ps, contacts.cellSize);
 }
 
-void GranularStage::partition(const GranularBodySystem& ps) {
+void GranularStage::partition(const GranularBodySystem& ps, Real cellSize) {
   // Slabs along the axis of largest extent of the particle cloud, each at least one grid cell wide (the
   // largest particle-pair reach), so a contact's two particles lie in the same or adjacent slabs. A unit
   // belongs to the lower slab of its particles: units of two even (or two odd) slabs never share a particle.
@@ -280,7 +272,7 @@ void GranularStage::partition(const GranularBodySystem& ps) {
   const Vec3 ext = (hi - lo).cwiseMax(Vec3::Zero());
   if (ext.y() > ext[axis]) axis = 1;
   if (ext.z() > ext[axis]) axis = 2;
-  const Real cell = collider_.getCellSize();
+  const Real cell = cellSize;
   int numSlabs = cell > 0 ? int(std::min<Real>(kMaxSlabs, std::floor(ext[axis] / cell))) : 1;
   if (numSlabs < 4 || nu < kParallelMin) numSlabs = 1;  // too narrow or too small to be worth splitting
   const Real width = numSlabs > 1 ? ext[axis] / Real(numSlabs) : 1.0;
@@ -289,7 +281,8 @@ void GranularStage::partition(const GranularBodySystem& ps) {
     return std::clamp(int(std::floor((x[i][axis] - lo[axis]) / width)), 0, numSlabs - 1);
   };
   slabOf_.resize(nu);
-  std::vector<uint32_t> count(size_t(numSlabs) + 2, 0);
+  auto& count = slabCount_;
+  count.assign(size_t(numSlabs) + 2, 0);
   for (size_t k = 0; k < nu; ++k) {
     const Unit& u = scratchUnits_[k];
     int sl;
@@ -302,7 +295,8 @@ void GranularStage::partition(const GranularBodySystem& ps) {
   }
   slabStart_.assign(size_t(numSlabs) + 3, 0);
   for (int sl = 0; sl <= numSlabs + 1; ++sl) slabStart_[size_t(sl) + 1] = slabStart_[size_t(sl)] + count[size_t(sl)];
-  std::vector<uint32_t> cursor(slabStart_.begin(), slabStart_.end() - 1);
+  auto& cursor = slabCursor_;
+  cursor.assign(slabStart_.begin(), slabStart_.end() - 1);
   units_.resize(nu);
   for (size_t k = 0; k < nu; ++k) units_[cursor[slabOf_[k]]++] = scratchUnits_[k];
   numSlabs_ = numSlabs;
@@ -330,22 +324,40 @@ void GranularStage::prepare(GranularBodySystem& ps, std::vector<SolverBodyState>
   }
 }
 
+template <int kFrozen>
 void GranularStage::solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& w, const std::vector<Real>& invM,
                               const std::vector<Real>& invI, std::vector<SolverBodyState>& bodies,
                               Real& maxDelta) const {
+  static_assert(kFrozen >= -1 && kFrozen <= 1);
   const uint32_t a = u.a;
   const int32_t b = u.b;
   SolverBodyState* body = (b < 0 && u.body >= 0) ? &bodies[size_t(u.body)] : nullptr;
-  const bool bodyDyn = body && body->invMass > 0;
+  // A frozen side never moves; in the shock pass side B is a particle or a static/kinematic support.
+  const bool moveA = kFrozen != 0;
+  const bool bodyDyn = kFrozen < 0 && body && body->invMass > 0;
   auto relVel = [&]() -> Vec3 {
     Vec3 vr = v[a] + w[a].cross(u.ra);
     if (b >= 0) vr -= v[size_t(b)] + w[size_t(b)].cross(u.rb);
     else if (body) vr -= body->v + body->w.cross(u.rb);
     return vr;
   };
+  // 1 / (J M^-1 J^T + e) along d: precomputed for both sides moving, else that of the free particle alone.
+  auto gain = [&](Real both, const Vec3& d, Real e) {
+    if constexpr (kFrozen < 0) {
+      return both;
+    } else {
+      const size_t p = moveA ? a : size_t(b);
+      const Vec3& rp = moveA ? u.ra : u.rb;
+      return 1.0 / (invM[p] + invI[p] * rp.cross(d).squaredNorm() + e);
+    }
+  };
+  // Impulse P on side A (and -P on side B).
   auto applyP = [&](const Vec3& P) {
-    v[a] += invM[a] * P;
-    w[a] += invI[a] * u.ra.cross(P);
+    if (moveA) {
+      v[a] += invM[a] * P;
+      w[a] += invI[a] * u.ra.cross(P);
+    }
+    if (kFrozen == 1) return;
     if (b >= 0) {
       v[size_t(b)] -= invM[size_t(b)] * P;
       w[size_t(b)] -= invI[size_t(b)] * u.rb.cross(P);
@@ -358,39 +370,39 @@ void GranularStage::solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& 
   // Normal.
   {
     const Real vn = u.n.dot(relVel());
-    const Real nl = std::max(u.lN + (u.rhsN - vn - u.eN * u.lN) * u.kN, u.loN);
+    const Real nl = std::max(u.lN + (u.rhsN - vn - u.eN * u.lN) * gain(u.kN, u.n, u.eN), u.loN);
     const Real d = nl - u.lN;
     u.lN = nl;
     if (d != 0) applyP(d * u.n);
-    maxDelta = std::max(maxDelta, std::abs(d));
+    if constexpr (kFrozen < 0) maxDelta = std::max(maxDelta, std::abs(d));
   }
   // Friction: scalar updates of both tangents at the same velocity, then projection onto the disc.
   if (u.mu > 0) {
     const Vec3 vr = relVel();
-    Real l1 = u.lT1 + (-u.t1.dot(vr) - u.eT * u.lT1) * u.kT1;
-    Real l2 = u.lT2 + (-u.t2.dot(vr) - u.eT * u.lT2) * u.kT2;
-    const Real lim = std::isinf(u.mu) ? 1e300 : u.mu * std::max<Real>(u.lN, 0);
-    projectOntoDisc(l1, l2, lim);
+    Real l1 = u.lT1 + (u.rhsT1 - u.t1.dot(vr) - u.eT * u.lT1) * gain(u.kT1, u.t1, u.eT);
+    Real l2 = u.lT2 + (u.rhsT2 - u.t2.dot(vr) - u.eT * u.lT2) * gain(u.kT2, u.t2, u.eT);
+    projectOntoDisc(l1, l2, frictionLimit(u.mu, u.lN));
     const Real d1 = l1 - u.lT1, d2 = l2 - u.lT2;
     u.lT1 = l1;
     u.lT2 = l2;
     if (d1 != 0 || d2 != 0) applyP(d1 * u.t1 + d2 * u.t2);
   }
   // Rolling resistance: torque about the tangents opposing the relative rolling, disc bound.
-  if (u.rollMu > 0 && u.kR > 0) {
-    Vec3 wr = w[a];
-    if (b >= 0) wr -= w[size_t(b)];
-    else if (body) wr -= body->w;
-    Real l1 = u.lR1 + (-u.t1.dot(wr) - u.eT * u.lR1) * u.kR;
-    Real l2 = u.lR2 + (-u.t2.dot(wr) - u.eT * u.lR2) * u.kR;
-    const Real lim = u.rollMu * std::max<Real>(u.lN, 0);
-    projectOntoDisc(l1, l2, lim);
-    const Vec3 T = (l1 - u.lR1) * u.t1 + (l2 - u.lR2) * u.t2;
-    u.lR1 = l1;
-    u.lR2 = l2;
-    w[a] += invI[a] * T;
-    if (b >= 0) w[size_t(b)] -= invI[size_t(b)] * T;
-    else if (bodyDyn) body->w -= body->invInertia * T;
+  if constexpr (kFrozen < 0) {
+    if (u.rollMu > 0 && u.kR > 0) {
+      Vec3 wr = w[a];
+      if (b >= 0) wr -= w[size_t(b)];
+      else if (body) wr -= body->w;
+      Real l1 = u.lR1 + (-u.t1.dot(wr) - u.eT * u.lR1) * u.kR;
+      Real l2 = u.lR2 + (-u.t2.dot(wr) - u.eT * u.lR2) * u.kR;
+      projectOntoDisc(l1, l2, u.rollMu * std::max<Real>(u.lN, 0));
+      const Vec3 T = (l1 - u.lR1) * u.t1 + (l2 - u.lR2) * u.t2;
+      u.lR1 = l1;
+      u.lR2 = l2;
+      w[a] += invI[a] * T;
+      if (b >= 0) w[size_t(b)] -= invI[size_t(b)] * T;
+      else if (bodyDyn) body->w -= body->invInertia * T;
+    }
   }
 }
 
@@ -402,9 +414,9 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
   auto runRange = [&](uint32_t b0, uint32_t b1) {
     Real md = 0;
     if (!backward)
-      for (uint32_t k = b0; k < b1; ++k) solveUnit(units_[k], v, w, invM, invInertia_, bodies, md);
+      for (uint32_t k = b0; k < b1; ++k) solveUnit<-1>(units_[k], v, w, invM, invInertia_, bodies, md);
     else
-      for (uint32_t k = b1; k-- > b0;) solveUnit(units_[k], v, w, invM, invInertia_, bodies, md);
+      for (uint32_t k = b1; k-- > b0;) solveUnit<-1>(units_[k], v, w, invM, invInertia_, bodies, md);
     return md;
   };
   const int S = numSlabs_;
@@ -427,46 +439,6 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
   }
   if (!backward) maxDelta = std::max(maxDelta, runRange(serialBegin, serialEnd));
   return maxDelta;
-}
-
-void GranularStage::solveUnitFrozen(Unit& u, int frozen, std::vector<Vec3>& v, std::vector<Vec3>& w,
-                                    const std::vector<Real>& invM, const std::vector<Real>& invI,
-                                    const std::vector<SolverBodyState>& bodies) const {
-  // Particle p is the free side; q (particle or static geometry) is held. Directions below act on p along
-  // +d when p is side A, -d when p is side B.
-  const bool pIsA = frozen == 1;
-  const size_t p = pIsA ? u.a : size_t(u.b);
-  const Vec3& rp = pIsA ? u.ra : u.rb;
-  const Real sgn = pIsA ? 1.0 : -1.0;
-  auto relVel = [&]() -> Vec3 {
-    Vec3 vr = v[u.a] + w[u.a].cross(u.ra);
-    if (u.b >= 0) vr -= v[size_t(u.b)] + w[size_t(u.b)].cross(u.rb);
-    else if (u.body >= 0) vr -= bodies[size_t(u.body)].v + bodies[size_t(u.body)].w.cross(u.rb);
-    return vr;
-  };
-  auto kInv = [&](const Vec3& d, Real e) { return 1.0 / (invM[p] + invI[p] * rp.cross(d).squaredNorm() + e); };
-  auto applyP = [&](const Vec3& P) {  // P acts on side A
-    v[p] += sgn * invM[p] * P;
-    w[p] += sgn * invI[p] * rp.cross(P);
-  };
-  {
-    const Real vn = u.n.dot(relVel());
-    const Real nl = std::max(u.lN + (u.rhsN - vn - u.eN * u.lN) * kInv(u.n, u.eN), u.loN);
-    const Real d = nl - u.lN;
-    u.lN = nl;
-    if (d != 0) applyP(d * u.n);
-  }
-  if (u.mu > 0) {
-    const Vec3 vr = relVel();
-    Real l1 = u.lT1 + (-u.t1.dot(vr) - u.eT * u.lT1) * kInv(u.t1, u.eT);
-    Real l2 = u.lT2 + (-u.t2.dot(vr) - u.eT * u.lT2) * kInv(u.t2, u.eT);
-    const Real lim = std::isinf(u.mu) ? 1e300 : u.mu * std::max<Real>(u.lN, 0);
-    projectOntoDisc(l1, l2, lim);
-    const Real d1 = l1 - u.lT1, d2 = l2 - u.lT2;
-    u.lT1 = l1;
-    u.lT2 = l2;
-    if (d1 != 0 || d2 != 0) applyP(d1 * u.t1 + d2 * u.t2);
-  }
 }
 
 void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies, const Vec3& up,
@@ -492,8 +464,13 @@ void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyStat
   std::sort(shockOrder_.begin(), shockOrder_.end());
   auto& v = ps.velocities();
   auto& w = ps.angularVelocities();
+  Real unused = 0;
   for (int s = 0; s < sweeps; ++s)
-    for (const auto& [h, code] : shockOrder_) solveUnitFrozen(units_[code >> 1], int(code & 1), v, w, ps.invMasses(), invInertia_, bodies);
+    for (const auto& [h, code] : shockOrder_) {
+      Unit& u = units_[code >> 1];
+      if (code & 1) solveUnit<1>(u, v, w, ps.invMasses(), invInertia_, bodies, unused);
+      else solveUnit<0>(u, v, w, ps.invMasses(), invInertia_, bodies, unused);
+    }
 }
 
 void GranularStage::appendDirectRows(const GranularBodySystem& ps, std::vector<ConstraintRow>& rows,
@@ -529,13 +506,7 @@ void GranularStage::appendDirectRows(const GranularBodySystem& ps, std::vector<C
     directRow_.push_back(uint32_t(normal));
     // Same rows as solveUnit: impulse P along +d on a, -d on b (or the body); J v = relative velocity along d.
     auto linear = [&](const Vec3& d) {
-      ConstraintRow r;
-      r.bodyA = ia;
-      r.bodyB = ib;
-      r.jLinA = d;
-      r.jAngA = u.ra.cross(d);
-      r.jLinB = -d;
-      r.jAngB = -u.rb.cross(d);
+      ConstraintRow r = pointRow(ia, ib, u.ra, u.rb, d);
       r.solveType = type;
       return r;
     };
@@ -548,6 +519,7 @@ void GranularStage::appendDirectRows(const GranularBodySystem& ps, std::vector<C
     if (u.mu > 0) {
       for (int j = 0; j < 2; ++j) {
         ConstraintRow f = linear(j == 0 ? u.t1 : u.t2);
+        f.rhs = j == 0 ? u.rhsT1 : u.rhsT2;
         f.e = u.eT;
         f.mu = u.mu;  // infinite: unbounded
         f.normalRow = normal;
@@ -649,9 +621,10 @@ void GranularStage::integrate(GranularBodySystem& ps, Real h, std::vector<size_t
   }
 }
 
-void GranularStage::storeResults(const GranularBodySystem& ps, Real h) {
-  auto& pp = collider_.getParticleParticleContacts();
-  auto& pg = collider_.getParticleGeometryContacts();
+void GranularStage::storeResults(const GranularBodySystem& ps, const ParticleContactLists& contacts, Real h) {
+  auto& pp = *contacts.particleParticle;
+  auto& pg = *contacts.particleGeometry;
+  const auto& sides = *contacts.geometrySides;
   const Real invH = 1.0 / h;
   nextPp_.clear();
   nextPg_.clear();
@@ -668,7 +641,7 @@ void GranularStage::storeResults(const GranularBodySystem& ps, Real h) {
       const Real s = u.flip ? -1.0 : 1.0;
       nextPp_.push_back({u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0, u.lN, s * F, s * T, u.impact});
     } else {
-      nextPg_.push_back({sa << 32 | c.geometry->getId(), c.featureId, u.lN, F, T, u.impact});
+      nextPg_.push_back({sa << 32 | sides[u.src].geometryId, c.featureId, u.lN, F, T, u.impact});
     }
   }
   std::sort(nextPp_.begin(), nextPp_.end());

@@ -1,35 +1,37 @@
-// GranularStage: the particle path of Simulation::stepForward (internal to the solver module).
+// GranularStage: the particle path of Simulation::stepForward after collision (internal to the solver module).
+// The particle contact lists come from the collide stage (ParticleCollider, collide_stage.cpp); this stage
+// turns them into contact units, solves and integrates them. It includes no collide header: what it needs of a
+// contact's geometry (body, material, rolling radius, id) arrives as a ParticleGeometrySide per contact.
 //
-// Stages, called by Simulation in step order:
-//   collide    ParticleCollider (grid pairs, particle vs every geometry), every kReorderInterval steps the
-//              particles are first reordered along the grid for cache locality (ids stay stable)
-//   buildRows  one contact unit per particle contact point: a SPOOK normal row, two friction rows (projected
-//              cone, bound mu * normal impulse), and with rolling resistance two angular rows (disc bound
-//              coefficient * r_eff * normal impulse). Parameters come from the MaterialManager exactly as
-//              for rigid contacts (explicit contact material, else the combination rules). Adhesion: the
-//              normal impulse may pull down to -adhesiveForce * h and the rest overlap is the adhesive
-//              overlap. Speculative contacts (gap > 0): the row only forbids closing more than the gap in one
-//              step. Warm start from last step's impulses keyed by particle slots (stable across destroy of
-//              other particles and reorder) and geometry id + feature.
-//              Then the free velocities: v += h g.
-//   sweep      one projected Gauss-Seidel sweep, parallel by a two-colouring of spatial slabs: the cloud is cut
-//              into up to 64 slabs along its longest axis, each at least one grid cell wide, and a unit belongs
-//              to the lower slab of its particles, so units of different even slabs (or odd slabs) never share
-//              a particle. Even slabs run in parallel (OpenMP, one thread per slab, serial Gauss-Seidel inside),
-//              then odd slabs; units touching a dynamic rigid body run serially last. The partition depends on
-//              positions only, so results are bit-identical for any thread count, and a sweep costs two
-//              barriers (a greedy per-contact colouring needed ~20, which on a shared, oversubscribed machine
-//              cost more than the sweep). Small or narrow systems (< 4 slabs or < 2048 units) run serially.
-//              Sweeps alternate forward / backward (symmetric Gauss-Seidel, as the rigid PGS).
-//   integrate  x += h v for live particles; a particle whose velocity or position turns non-finite is
-//              reported by id, keeps its last position and is stopped.
-//   store      forces into the contact lists, impulses into the warm-start cache.
+// Stages, called by Simulation's stages in step order:
+//   applyForces  free velocities v += h g (the start-of-step velocities are kept for the rows)
+//   buildRows    one contact unit per particle contact point: a SPOOK normal row (contact_law.h, the same law
+//                as rigid contacts), two friction rows (projected cone, bound mu * normal impulse), and with
+//                rolling resistance two angular rows (disc bound coefficient * r_eff * normal impulse).
+//                Parameters come from the MaterialManager exactly as for rigid contacts (explicit contact
+//                material, else the combination rules). Adhesion: the normal impulse may pull down to
+//                -adhesiveForce * h and the rest overlap is the adhesive overlap. Speculative contacts (gap > 0):
+//                the row only forbids closing more than the gap in one step. Warm start from last step's
+//                impulses keyed by particle slots (stable across destroy of other particles and reorder) and
+//                geometry id + feature.
+//   sweep        one projected Gauss-Seidel sweep, parallel over spatial slabs: the cloud is cut into up to 64
+//                slabs along its longest axis, each at least one grid cell wide, and a unit belongs to the lower
+//                slab of its particles, so units of two even slabs (or two odd slabs) never share a particle.
+//                Even slabs run in parallel (OpenMP, one thread per slab, serial Gauss-Seidel inside), then odd
+//                slabs; units touching a dynamic rigid body run serially last. The partition depends on positions
+//                only, so results are bit-identical for any thread count, and a sweep costs two barriers (the
+//                reason for slabs rather than a per-contact graph colouring, docs/solver-internals.md). Small
+//                or narrow systems (< 4 slabs or < 2048 units) run serially. Sweeps alternate forward /
+//                backward (symmetric Gauss-Seidel, as the rigid PGS).
+//   integrate    x += h v for live particles; a particle whose velocity or position turns non-finite is
+//                reported by id, keeps its last position and is stopped.
+//   store        forces into the contact lists, impulses into the warm-start cache.
 //
 // DIRECT mode (AGX manual: particle solve type agx::FrictionModel::DIRECT, with infinite friction and adhesion
 // and zero adhesive overlap a stiff, glued lump): a unit whose resolved contact material's solve type is not
 // ITERATIVE (DIRECT, SPLIT or DIRECT_AND_ITERATIVE; needs SuiteSparse, else every unit stays iterative) is
 // put in its own range after the serial set by partition, and the sweeps and the shock pass skip it. In
-// Simulation::solve, after prepare (warm start), appendDirectRows appends one SolverBodyState per particle of
+// the solve stage, after prepare (warm start), appendDirectRows appends one SolverBodyState per particle of
 // such units after the rigid bodies and the units' rows as ConstraintRows: the normal row with the unit's SPOOK
 // rhs, e and lower bound (infinite adhesion: unbounded), two friction rows scaled by the normal row
 // (normalRow / mu; infinite mu: unbounded) and the two rolling rows if any. They carry the material's solve
@@ -48,27 +50,47 @@
 #include <functional>
 #include <vector>
 
-#include "scree/collide/particle_collider.h"
 #include "scree/core/granular_body_system.h"
 #include "scree/core/material.h"
+#include "scree/core/particle_contact.h"
+#include "scree/core/rigid_body.h"
 #include "scree/solver/constraint_row.h"
 #include "scree/solver/pgs.h"
 #include "scree/solver/solver.h"
 
 namespace scree::detail {
 
+/// What the particle rows need of the geometry of one particle-geometry contact (filled by the collide stage).
+struct ParticleGeometrySide {
+  const RigidBody* body = nullptr;  ///< the geometry's body, or null
+  const Material* material = nullptr;
+  Real rollingRadius = 0;           ///< m, 0: the shape does not roll
+  uint32_t geometryId = 0;
+};
+
+/// The particle contacts of this step as the collide stage found them (listeners may have modified them).
+struct ParticleContactLists {
+  std::vector<ParticleContact>* particleParticle = nullptr;
+  std::vector<ParticleContact>* particleGeometry = nullptr;
+  const std::vector<ParticleGeometrySide>* geometrySides = nullptr;  ///< one per particleGeometry contact
+  Real cellSize = 0;  ///< grid cell of the collision: no particle pair in contact is farther apart
+};
+
 class GranularStage {
  public:
+  /// Steps between locality reorders of the particle arrays (done by the collide stage).
   static constexpr int kReorderInterval = 50;
 
   /// True when there is anything for the particle path to do this step.
   bool active(const GranularBodySystem& ps) const { return ps.size() > 0 || !units_.empty(); }
 
-  void collide(GranularBodySystem& ps, const std::vector<GeometryRef>& geometries, Real h);
-  /// solverIndexOf maps a body to its index in `bodies` (-1 when not in the simulation).
-  void buildRows(GranularBodySystem& ps, const MaterialManager& materials, const Solver& solver,
-                 std::vector<SolverBodyState>& bodies, const std::function<int(const RigidBody*)>& solverIndexOf,
-                 const Vec3& gravity, Real h);
+  /// Free velocities v += h g of the particles; the start-of-step velocities are kept for buildRows.
+  void applyForces(GranularBodySystem& ps, const Vec3& gravity, Real h);
+  /// The contact units of `contacts` (after applyForces). solverIndexOf maps a body to its index in `bodies`
+  /// (-1 when not in the simulation).
+  void buildRows(GranularBodySystem& ps, const ParticleContactLists& contacts, const MaterialManager& materials,
+                 const Solver& solver, std::vector<SolverBodyState>& bodies,
+                 const std::function<int(const RigidBody*)>& solverIndexOf, const Vec3& gravity, Real h);
   /// Applies the warm-start impulses.
   void prepare(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies);
   /// One sweep; `backward` reverses the order. Returns the largest |delta lambda|.
@@ -101,10 +123,8 @@ class GranularStage {
   /// Positions; non-finite particles are appended to outNonFinite (ids) with a message each.
   void integrate(GranularBodySystem& ps, Real h, std::vector<size_t>& outNonFinite, std::vector<std::string>& outMessages,
                  Real time);
-  void storeResults(const GranularBodySystem& ps, Real h);
-
-  const std::vector<ParticleContact>& particleParticleContacts() const { return collider_.getParticleParticleContacts(); }
-  const std::vector<ParticleContact>& particleGeometryContacts() const { return collider_.getParticleGeometryContacts(); }
+  /// Forces into `contacts` (the lists buildRows read), impulses into the warm-start cache.
+  void storeResults(const GranularBodySystem& ps, const ParticleContactLists& contacts, Real h);
   size_t numUnits() const { return units_.size(); }
   int numSlabs() const { return numSlabs_; }
 
@@ -119,6 +139,7 @@ class GranularStage {
     Vec3 ra = Vec3::Zero(), rb = Vec3::Zero();  // contact point relative to a's centre and b's centre / body's cm
     Real kN = 0, kT1 = 0, kT2 = 0, kR = 0;     // 1 / (J M^-1 J^T + e) of normal, tangents, rolling
     Real rhsN = 0, eN = 0, loN = 0, eT = 0, mu = 0, rollMu = 0;
+    Real rhsT1 = 0, rhsT2 = 0;  // friction targets: the surface velocity along t1, t2 (0 unless overridden)
     Real lN = 0, lT1 = 0, lT2 = 0, lR1 = 0, lR2 = 0;
     Real impact = 0;      // approach speed of a speculative stop this step, remembered for next step's bounce
     bool flip = false;    // a's slot is the higher one of the pair (warm-start vectors are stored for the lower)
@@ -135,22 +156,38 @@ class GranularStage {
     bool operator<(const CacheEntry& o) const { return key != o.key ? key < o.key : feature < o.feature; }
   };
   const CacheEntry* find(const std::vector<CacheEntry>& cache, uint64_t key, uint32_t feature) const;
+  /// One Gauss-Seidel update of unit u (normal, then friction disc, then rolling disc). kFrozen < 0: both
+  /// sides move (the sweeps; |delta lambda| goes into maxDelta). kFrozen = 0 or 1: side A or B is held
+  /// immovable (the shock pass), the effective masses are those of the free particle alone and rolling is
+  /// left to the sweeps.
+  template <int kFrozen>
   void solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& w, const std::vector<Real>& invM,
                  const std::vector<Real>& invI, std::vector<SolverBodyState>& bodies, Real& maxDelta) const;
-  void partition(const GranularBodySystem& ps);
-  /// One update of u with side A (frozen = 0) or B (frozen = 1) held immovable.
-  void solveUnitFrozen(Unit& u, int frozen, std::vector<Vec3>& v, std::vector<Vec3>& w, const std::vector<Real>& invM,
-                       const std::vector<Real>& invI, const std::vector<SolverBodyState>& bodies) const;
+  void partition(const GranularBodySystem& ps, Real cellSize);
 
-  ParticleCollider collider_;
-  uint64_t stepCount_ = 0;
-  std::vector<Unit> units_;          // all units, the parallel ones grouped by colour first
+  std::vector<Unit> units_;          // all units: the slabs in order, then the serial set, then DIRECT mode
   // [numSlabs + 3] ranges into units_: numSlabs slabs, the serial set, the DIRECT-mode units.
   std::vector<uint32_t> slabStart_;
   int numSlabs_ = 1;
   std::vector<Real> invInertia_;     // [size()] 1 / (0.4 m r^2)
+  std::vector<Vec3> vStart_;         // [size()] velocities at the start of the step (before applyForces)
+  // Per-step buffers, kept to reuse their memory.
   std::vector<Unit> scratchUnits_;
   std::vector<uint16_t> slabOf_;
+  std::vector<uint32_t> slabCount_, slabCursor_;
+  // Contact parameters resolved once per material pair per step.
+  struct PairParams {
+    Real youngsModulus = 0, damping = 0;  // of the pair's material (per-point overrides recompute the SPOOK terms)
+    Real eN = 0, a = 0, upsilon = 1;      // SPOOK normal row
+    Real eT = 0;                          // friction-row regularisation
+    Real mu = 0, rest = 0, rolling = 0, adhF = 0, adhO = 0;
+    uint8_t solveType = FrictionModel::ITERATIVE;  // ITERATIVE, or DIRECT mode (see the file comment)
+  };
+  static PairParams makeParams(const SurfaceParameters& s, const FrictionModel* fm, Real h);
+  std::vector<PairParams> ppParams_;  // [K * K] particle material pairs
+  std::vector<std::pair<std::pair<uint32_t, const Material*>, PairParams>> pgParams_;  // pairs met this step
+  std::vector<uint32_t> pgParam_, pgUnit_;  // per particle-geometry contact: its pgParams_ entry and unit
+  std::vector<int32_t> pgBody_;             // per particle-geometry contact: solver body, -1 none
   std::vector<std::pair<Real, uint32_t>> shockOrder_;  // (height of the lower side, unit * 2 + frozen side)
   std::vector<CacheEntry> ppCache_, pgCache_, nextPp_, nextPg_;
   // DIRECT mode, valid between appendDirectRows and finishDirect.

@@ -6,6 +6,8 @@
 
 namespace scree {
 
+using detail::ConstraintRow;  // the solver row type (scree/solver/constraint_row.h)
+
 namespace {
 Quat frameFromAxis(const Vec3& axis) {
   // Frame whose z axis is `axis` (unit): rotation taking e_z to axis.

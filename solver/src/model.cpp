@@ -5,6 +5,7 @@
 
 #include "scree/core/errors.h"
 #include "scree/solver/simulation.h"
+#include "simulation_state.h"
 
 namespace scree {
 
@@ -63,20 +64,20 @@ void Simulation::add(ModelRef model) {
   if (model->getSimulation() != nullptr)
     throw std::invalid_argument("Simulation::add: model \"" + model->getModelName() +
                                 "\" is invalid (already in another simulation)");
-  models_.push_back(model);
+  s_->models.push_back(model);
   try {
     model->attach(*this);
   } catch (...) {
-    models_.pop_back();
+    s_->models.pop_back();
     throw;
   }
 }
 
 bool Simulation::remove(const ModelRef& model) {
-  auto it = std::find(models_.begin(), models_.end(), model);
-  if (it == models_.end()) return false;
+  auto it = std::find(s_->models.begin(), s_->models.end(), model);
+  if (it == s_->models.end()) return false;
   ModelRef keep = *it;  // the model may hold the last reference to itself through its items
-  models_.erase(it);
+  s_->models.erase(it);
   keep->detach(*this);
   return true;
 }

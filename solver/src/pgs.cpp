@@ -3,18 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "contact_law.h"
 #include "scree/core/assert.h"
 
-namespace scree {
+namespace scree::detail {
 
 namespace {
 const SolverBodyState kStatic{};
-
-// mu * lambda_n with mu = +inf meaning "no slip" (and inf * 0 not turning into NaN).
-inline Real frictionLimit(Real mu, Real lambdaN) {
-  if (std::isinf(mu)) return 1e300;
-  return mu * std::max<Real>(lambdaN, 0);
-}
 
 inline Real rowVelocity(const ConstraintRow& r, const std::vector<SolverBodyState>& b) {
   Real jv = 0;
@@ -71,12 +66,7 @@ static Real solveUnit(std::vector<ConstraintRow>& rows, std::vector<SolverBodySt
     Real d2 = (s.rhs - rowVelocity(s, bodies) - s.e * s.lambda) * s.invDiag;
     Real l1 = r.lambda + d1, l2 = s.lambda + d2;
     const Real lim = r.normalRow >= 0 ? frictionLimit(r.mu, rows[r.normalRow].lambda) : r.hi;
-    const Real mag = std::sqrt(l1 * l1 + l2 * l2);
-    if (mag > lim) {
-      const Real sc = mag > 0 ? lim / mag : 0;
-      l1 *= sc;
-      l2 *= sc;
-    }
+    projectOntoDisc(l1, l2, lim);
     d1 = l1 - r.lambda;
     d2 = l2 - s.lambda;
     r.lambda = l1;
@@ -216,4 +206,4 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
   }
 }
 
-}  // namespace scree
+}  // namespace scree::detail

@@ -1,5 +1,6 @@
-// Rolling radius of a geometry for rolling resistance (solver-private; rigid contacts in simulation.cpp and
-// particle–geometry contacts in granular_stage.cpp): spheres, cylinders and capsules roll, other shapes do not.
+// Rolling radius of a geometry for rolling resistance (solver-private; rigid contacts in contact_rows.cpp, and
+// particle-geometry contacts through the collide stage, collide_stage.cpp): spheres, cylinders and capsules
+// roll, other shapes do not.
 #pragma once
 
 #include "scree/collide/geometry.h"

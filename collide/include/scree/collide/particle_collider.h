@@ -25,7 +25,7 @@
 #include "scree/core/granular_body_system.h"
 #include "scree/core/particle_contact.h"
 
-namespace scree {
+namespace scree::detail {
 
 class ParticleCollider {
  public:
@@ -61,4 +61,4 @@ class ParticleCollider {
   std::vector<ParticleContact> pp_, pg_;
 };
 
-}  // namespace scree
+}  // namespace scree::detail

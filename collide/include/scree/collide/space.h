@@ -37,7 +37,7 @@ class Space {
   void setContactMargin(Real m);
   Real getContactMargin() const { return margin_; }
 
-  UniformGrid& getBroadphase() { return grid_; }
+  detail::UniformGrid& getBroadphase() { return grid_; }
 
   /// Updates world transforms, computes AABBs grown by each body's motion over `h` (speculative contacts),
   /// runs broad- and narrowphase and replaces the contents of `out` with the touching pairs (its elements and
@@ -53,7 +53,7 @@ class Space {
   }
   std::vector<GeometryRef> geoms_;
   std::set<uint64_t> disabledGroups_, disabledGeoms_, disabledBodies_;
-  UniformGrid grid_;
+  detail::UniformGrid grid_;
   Real margin_ = 1e-3;
   size_t numPairs_ = 0;
   // scratch

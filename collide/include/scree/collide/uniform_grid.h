@@ -14,7 +14,7 @@
 
 #include "scree/core/math.h"
 
-namespace scree {
+namespace scree::detail {
 
 class UniformGrid {
  public:
@@ -49,4 +49,4 @@ class UniformGrid {
   std::vector<uint64_t> pairKeys_;
 };
 
-}  // namespace scree
+}  // namespace scree::detail

@@ -149,6 +149,19 @@ class GranularBodySystem {
   /// Bumped by every create, destroy, reorder, radius or material change (lets engine caches detect change).
   uint64_t getRevision() const { return revision_; }
 
+  // ---- collision groups (AGX: agx::GranularBodySystem's groups, for the whole system) -----------------------
+  /// The particles' collision groups: a particle-geometry pair is not collided when any (particle group,
+  /// geometry group) pair is disabled in the simulation (Simulation::setEnableCollisions). Names share the
+  /// ids of Geometry::addGroup(const std::string&). Adding a group twice is a no-op; an empty name throws.
+  void addGroup(uint32_t id);
+  void addGroup(const std::string& name);
+  /// False when the group was not there.
+  bool removeGroup(uint32_t id);
+  bool removeGroup(const std::string& name);
+  bool hasGroup(uint32_t id) const;
+  bool hasGroup(const std::string& name) const;
+  const std::vector<uint32_t>& getGroups() const { return groups_; }
+
  private:
   struct Slot {
     uint32_t dense = 0;       // dense index while live
@@ -181,6 +194,7 @@ class GranularBodySystem {
   size_t numDeadDense_ = 0;
   int deferDepth_ = 0;
   uint64_t revision_ = 0;
+  std::vector<uint32_t> groups_;
 };
 
 }  // namespace scree

@@ -3,7 +3,10 @@
 
 #include <memory>
 
+#include <vector>
+
 #include "scree/core/contact.h"
+#include "scree/core/particle_contact.h"
 
 namespace scree {
 
@@ -44,9 +47,24 @@ using ExecuteFilterRef = std::shared_ptr<ExecuteFilter>;
 /// the last. impact and contact may modify the contact (disable points, change normal, depth, per-point
 /// Young's modulus, damping, friction, restitution, surface velocity, or material()) before the solver reads
 /// it. Returning REMOVE_CONTACT removes the whole contact for this step.
+///
+/// particleContacts (mask bit PARTICLE_CONTACT, not in ALL): once per step, after collision and before the
+/// rows, with this step's particle contacts (ParticleContact: dense particle indices of this step). The
+/// listener may set the per-point overrides (enabled, youngsModulus, frictionCoefficient, damping,
+/// restitution, surfaceVelocity); it must not add, remove or reorder entries. The execute filter does not
+/// apply (particle contacts have no geometry pair on the particle side). Particles may be created and
+/// destroyed from it (destroys are deferred to the end of the step).
 class ContactEventListener {
  public:
-  enum ActivationMask { IMPACT = 1, CONTACT = 2, SEPARATION = 4, ALL = 7 };
+  /// ALL keeps its meaning: the three geometry-contact events. ALL_WITH_PARTICLES adds particle contacts.
+  enum ActivationMask {
+    IMPACT = 1,
+    CONTACT = 2,
+    SEPARATION = 4,
+    ALL = 7,
+    PARTICLE_CONTACT = 8,
+    ALL_WITH_PARTICLES = 15
+  };
   enum KeepContactPolicy { KEEP_CONTACT = 0, REMOVE_CONTACT = 1 };
 
   explicit ContactEventListener(int mask = ALL) : mask_(mask) {}
@@ -55,6 +73,9 @@ class ContactEventListener {
   virtual KeepContactPolicy impact(const TimeStamp&, GeometryContact&) { return KEEP_CONTACT; }
   virtual KeepContactPolicy contact(const TimeStamp&, GeometryContact&) { return KEEP_CONTACT; }
   virtual void separation(const TimeStamp&, Geometry* /*g0*/, Geometry* /*g1*/) {}
+  /// Particle-particle (b >= 0) and particle-geometry (b < 0, sensors included) contacts of this step.
+  virtual void particleContacts(const TimeStamp&, std::vector<ParticleContact>& /*particleParticle*/,
+                                std::vector<ParticleContact>& /*particleGeometry*/) {}
 
   int getMask() const { return mask_; }
   void setMask(int m) { mask_ = m; }

@@ -22,6 +22,16 @@ struct ParticleContact {
   Real depth = 0;
   uint32_t featureId = 0;   ///< narrowphase feature of the geometry (0 for particle pairs)
   bool sensor = false;      ///< the geometry is a sensor: reported, never solved
+  // --- per-point overrides a ContactEventListener may set (ContactEventListener::particleContacts), with the
+  // meaning of ContactPoint's; a negative value means "use the contact material" ------------------------------
+  bool enabled = true;               ///< false: the solver ignores this point this step
+  Real youngsModulus = -1;           ///< N/m per point (> 0 overrides)
+  Real frictionCoefficient = -1;     ///< (>= 0 overrides; +inf: no slip)
+  Real damping = -1;                 ///< SPOOK damping time, s (>= 0 overrides)
+  Real restitution = -1;             ///< (>= 0 overrides)
+  /// Target tangential velocity of particle a relative to particle b (or the geometry) at the point, world m/s
+  /// (a conveyor belt). Only its tangential part is used.
+  Vec3 surfaceVelocity = Vec3::Zero();
   // Results of the last step, on particle a.
   Real normalForce = 0;     ///< N
   Vec3 frictionForce = Vec3::Zero();  ///< N, world

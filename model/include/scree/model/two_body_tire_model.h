@@ -101,8 +101,8 @@ class TwoBodyTireModel : public Joint, public Model {
   bool getEnableFrictionAlignment() const { return alignFriction_; }
 
   // ---- used by the simulation -------------------------------------------------------------------------------
-  void addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) override;
-  void storeResult(const ConstraintRow* rows, const int* dofs, size_t count, Real h) override;
+  void addRows(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& outDofs) override;
+  void storeResult(const detail::ConstraintRow* rows, const int* dofs, size_t count, Real h) override;
   /// Install / uninstall the friction listener together with the constraint (file comment).
   void addNotification(Simulation& sim) override;
   void removeNotification(Simulation& sim) override;

@@ -63,9 +63,9 @@ class Constraint {
 
   // ---- used by the simulation ----------------------------------------------------------------------------
   /// Appends this step's rows. Row k of the output must record its DOF in `outDofs` (same length).
-  virtual void addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) = 0;
+  virtual void addRows(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& outDofs) = 0;
   /// Receives the solved rows appended by addRows (same order) to keep warm-start impulses and forces.
-  virtual void storeResult(const ConstraintRow* rows, const int* dofs, size_t count, Real h);
+  virtual void storeResult(const detail::ConstraintRow* rows, const int* dofs, size_t count, Real h);
   /// Called by Simulation::add / remove (AGX: addNotification / removeNotification): a model built on a
   /// constraint may register or unregister its listeners here. Default: nothing.
   virtual void addNotification(Simulation&) {}

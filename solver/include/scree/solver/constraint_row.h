@@ -10,7 +10,7 @@
 #include "scree/core/material.h"
 #include "scree/core/math.h"
 
-namespace scree {
+namespace scree::detail {
 
 struct ConstraintRow {
   int32_t bodyA = -1, bodyB = -1;  ///< indices into the solver body array, -1 = none
@@ -43,4 +43,4 @@ struct ConstraintRow {
   Real diag = 0;                         ///< J M^-1 J^T + e
 };
 
-}  // namespace scree
+}  // namespace scree::detail

@@ -39,7 +39,7 @@
 #include "scree/solver/pgs.h"
 #include "scree/solver/solver.h"
 
-namespace scree {
+namespace scree::detail {
 
 class DirectSolver {
  public:
@@ -78,4 +78,4 @@ class DirectSolver {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace scree
+}  // namespace scree::detail

@@ -52,14 +52,14 @@ class Joint : public Constraint {
   };
   FrameState state() const;
   /// Holonomic row for `dof`: translational along u (world), angular about a (world), or a custom Jacobian.
-  void pushLinear(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& dofs, int dof,
+  void pushLinear(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& dofs, int dof,
                   const FrameState& f, const Vec3& u, Real g, Real compliance, Real damping) const;
-  void pushAngular(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& dofs, int dof,
+  void pushAngular(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& dofs, int dof,
                    const Vec3& a, Real g, Real compliance, Real damping) const;
   /// Finishes a row whose Jacobian is set: SPOOK holonomic rhs from g (or velocity row when `velocityRow`).
-  void finishRow(const ConstraintContext& ctx, ConstraintRow& r, int dof, Real g, Real compliance, Real damping) const;
+  void finishRow(const ConstraintContext& ctx, detail::ConstraintRow& r, int dof, Real g, Real compliance, Real damping) const;
   /// Bending rows (two DOFs from firstDof) of hinge and cylindrical joints.
-  void pushBending(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& dofs,
+  void pushBending(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& dofs,
                    const FrameState& f, int firstDof) const;
   /// Displacement of A along B's z axis (m) and its rate (m/s): the free DOF of slider joints.
   Real slidePosition() const;
@@ -145,12 +145,12 @@ class Controlled1DJoint : public Joint {
   /// Its rate (rad/s or m/s).
   virtual Real getCurrentSpeed() const = 0;
 
-  void storeResult(const ConstraintRow* rows, const int* dofs, size_t count, Real h) override;
+  void storeResult(const detail::ConstraintRow* rows, const int* dofs, size_t count, Real h) override;
 
  protected:
   using Joint::Joint;
   /// Appends the controller rows for the free DOF with Jacobian (linA, angA, linB, angB).
-  void addControllerRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& dofs,
+  void addControllerRows(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& dofs,
                          int firstDof, const Vec3& linA, const Vec3& angA, const Vec3& linB, const Vec3& angB,
                          Real position) const;
   int controllerDof_ = 0;  ///< DOF index of the motor; range = +1, lock = +2
@@ -163,7 +163,7 @@ class BallJoint : public Joint {
  public:
   enum Dof { TRANSLATIONAL_1 = 0, TRANSLATIONAL_2, TRANSLATIONAL_3, NUM_DOFS };
   BallJoint(RigidBodyRef a, RigidBodyRef b, const Vec3& worldPoint);
-  void addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) override;
+  void addRows(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& outDofs) override;
 };
 
 class Hinge : public Controlled1DJoint {
@@ -171,7 +171,7 @@ class Hinge : public Controlled1DJoint {
   enum Dof { TRANSLATIONAL_1 = 0, TRANSLATIONAL_2, TRANSLATIONAL_3, ROTATIONAL_1, ROTATIONAL_2, MOTOR, RANGE, LOCK, NUM_DOFS };
   /// worldAxis must be finite and non-zero.
   Hinge(RigidBodyRef a, RigidBodyRef b, const Vec3& worldPoint, const Vec3& worldAxis);
-  void addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) override;
+  void addRows(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& outDofs) override;
   Real getAngle() const override;
   Real getCurrentSpeed() const override;
 
@@ -183,7 +183,7 @@ class Prismatic : public Controlled1DJoint {
  public:
   enum Dof { TRANSLATIONAL_1 = 0, TRANSLATIONAL_2, ROTATIONAL_1, ROTATIONAL_2, ROTATIONAL_3, MOTOR, RANGE, LOCK, NUM_DOFS };
   Prismatic(RigidBodyRef a, RigidBodyRef b, const Vec3& worldPoint, const Vec3& worldAxis);
-  void addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) override;
+  void addRows(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& outDofs) override;
   Real getAngle() const override;
   Real getCurrentSpeed() const override;
 };
@@ -193,7 +193,7 @@ class CylindricalJoint : public Controlled1DJoint {
  public:
   enum Dof { TRANSLATIONAL_1 = 0, TRANSLATIONAL_2, ROTATIONAL_1, ROTATIONAL_2, MOTOR, RANGE, LOCK, NUM_DOFS };
   CylindricalJoint(RigidBodyRef a, RigidBodyRef b, const Vec3& worldPoint, const Vec3& worldAxis);
-  void addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) override;
+  void addRows(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& outDofs) override;
   Real getAngle() const override;
   Real getCurrentSpeed() const override;
 };
@@ -207,7 +207,7 @@ class DistanceJoint : public Joint {
   /// m, > 0.
   void setRestLength(Real l);
   Real getCurrentLength() const;
-  void addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) override;
+  void addRows(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& outDofs) override;
 
  private:
   Vec3 localB_ = Vec3::Zero();
@@ -231,7 +231,7 @@ class Generic6DofJoint : public Joint {
   /// Current deviation of each DOF (A relative to B, in B's frame): translations (m), rotation vector (rad).
   Vec3 getTranslationError() const;
   Vec3 getRotationError() const;
-  void addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) override;
+  void addRows(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& outDofs) override;
 
  private:
   Mode modes_[NUM_DOFS];

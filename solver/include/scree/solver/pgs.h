@@ -15,7 +15,7 @@
 #include "scree/solver/constraint_row.h"
 #include "scree/solver/solver.h"
 
-namespace scree {
+namespace scree::detail {
 
 /// Velocities and inverse mass of one body as the solver sees it (world frame, at the centre of mass).
 struct SolverBodyState {
@@ -56,4 +56,4 @@ class PgsSolver {
                         const std::vector<ShockRange>& ranges, int maxSweeps);
 };
 
-}  // namespace scree
+}  // namespace scree::detail

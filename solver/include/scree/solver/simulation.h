@@ -1,8 +1,11 @@
 // Simulation (AGX: agxSDK::Simulation): owns the bodies, geometries, constraints and listeners, and runs
-// the step. stepForward() is a fixed pipeline of named stages (DESIGN.md §2):
-//   1 preCollide listeners   2-3 collision (Space: broadphase + narrowphase)   4 contact listeners
-//   5 pre listeners          6 rows (contacts, constraints)                     7 solve (PGS)
-//   8 integrate              9 post listeners
+// the step. stepForward() is a fixed pipeline of named stages (DESIGN.md §2), each timed in StepStats:
+//   PRE_COLLIDE listeners; collision (geometries synced with the space, Space broadphase + narrowphase,
+//   particle collision, contact materials resolved); contact listeners; PRE_STEP listeners; forces (free
+//   velocities); rows (contacts, constraints, particles); solve (PGS, DIRECT or hybrid, particle sweeps);
+//   integration; results stored; position projection; finiteness check; POST_STEP listeners; particle
+//   destroys deferred since collision applied (so listeners, post included, may create and destroy particles
+//   while reading this step's particle contacts).
 // No exceptions inside stepForward: a body whose state turns non-finite is reported (getLastStepReport(),
 // logged as an error naming the body), restored to its last finite state and stopped.
 #pragma once
@@ -28,10 +31,35 @@
 
 namespace scree {
 
-/// Wall-clock time of each stage of the last step, seconds, and counts.
+namespace detail {
+struct SimulationState;
+}
+
+/// Wall-clock time of each stage of the last step, in seconds (steady clock), in step order, and counts. The
+/// sums `collide`, `rows` and `integrate` keep their earlier meaning.
 struct StepStats {
-  double preCollide = 0, collide = 0, contactEvents = 0, pre = 0, rows = 0, solve = 0, integrate = 0, post = 0;
-  double total = 0;
+  double preCollide = 0;         ///< s, PRE_COLLIDE step listeners
+  double syncGeometries = 0;     ///< s, geometries added to or removed from bodies since the last step -> space
+  double collideGeometries = 0;  ///< s, Space broadphase and narrowphase
+  double collideParticles = 0;   ///< s, particle-particle and particle-geometry collision
+  double resolveMaterials = 0;   ///< s, contact material and friction model of each geometry contact
+  double collide = 0;            ///< s, syncGeometries + collideGeometries + collideParticles + resolveMaterials
+  double contactEvents = 0;      ///< s, impact / contact / separation listeners (and particle contact listeners)
+  double pre = 0;                ///< s, PRE_STEP step listeners
+  double applyForces = 0;        ///< s, free velocities v + h M^-1 f of bodies and particles
+  double contactRows = 0;        ///< s, rows of the geometry contacts (with warm start)
+  double constraintRows = 0;     ///< s, rows of joints and models
+  double particleRows = 0;       ///< s, particle contact units
+  double rows = 0;               ///< s, applyForces + contactRows + constraintRows + particleRows
+  double solve = 0;              ///< s, the velocity solve (PGS, DIRECT / hybrid, particle sweeps, shock pass)
+  double integrateMotion = 0;    ///< s, positions and rotations of bodies and particles from the solved velocities
+  double storeResults = 0;       ///< s, contact forces, warm-start caches and constraint results
+  double projectPositions = 0;   ///< s, post-step position projection (Solver::setUsePositionProjection)
+  double checkFinite = 0;        ///< s, non-finite bodies restored and stopped
+  double integrate = 0;          ///< s, integrateMotion + storeResults + projectPositions + checkFinite
+  double post = 0;               ///< s, POST_STEP step listeners
+  double compactParticles = 0;   ///< s, particle destroys deferred during the step applied (after post)
+  double total = 0;              ///< s, the whole step
   size_t numBroadphasePairs = 0;
   size_t numContacts = 0;
   size_t numContactPoints = 0;
@@ -88,83 +116,52 @@ class Simulation {
   bool remove(const std::shared_ptr<T>& model) {
     return remove(ModelRef(model));
   }
-  const std::vector<ModelRef>& getModels() const { return models_; }
+  const std::vector<ModelRef>& getModels() const;
 
-  const std::vector<RigidBodyRef>& getRigidBodies() const { return bodies_; }
-  const std::vector<ConstraintRef>& getConstraints() const { return constraints_; }
+  const std::vector<RigidBodyRef>& getRigidBodies() const;
+  const std::vector<ConstraintRef>& getConstraints() const;
   /// Geometries added without a body.
-  const std::vector<GeometryRef>& getStaticGeometries() const { return staticGeoms_; }
-  const std::vector<StepEventListenerRef>& getStepEventListeners() const { return stepListeners_; }
-  const std::vector<ContactEventListenerRef>& getContactEventListeners() const { return contactListeners_; }
+  const std::vector<GeometryRef>& getStaticGeometries() const;
+  const std::vector<StepEventListenerRef>& getStepEventListeners() const;
+  const std::vector<ContactEventListenerRef>& getContactEventListeners() const;
 
   /// s, finite and > 0. Default 1/60.
   void setTimeStep(Real h);
-  Real getTimeStep() const { return h_; }
+  Real getTimeStep() const;
   /// m/s^2, finite. Default (0, 0, -9.80665).
   void setUniformGravity(const Vec3& g);
-  Vec3 getUniformGravity() const { return gravity_; }
+  Vec3 getUniformGravity() const;
 
   void stepForward();
   /// Steps until getTimeStamp() >= time - h/2.
   void stepTo(Real time);
-  Real getTimeStamp() const { return time_; }
+  Real getTimeStamp() const;
 
-  MaterialManager& getMaterialManager() { return materials_; }
-  Solver& getSolver() { return solver_; }
+  MaterialManager& getMaterialManager();
+  Solver& getSolver();
   /// The particles of this simulation (AGX: agx::GranularBodySystem).
-  GranularBodySystem& getGranularBodySystem() { return granular_; }
-  const GranularBodySystem& getGranularBodySystem() const { return granular_; }
-  Space& getSpace() { return space_; }
-  /// Disable/enable collisions between two collision groups (see Geometry::addGroup).
-  void setEnableCollisions(uint32_t group1, uint32_t group2, bool enable) { space_.setEnablePair(group1, group2, enable); }
+  GranularBodySystem& getGranularBodySystem();
+  const GranularBodySystem& getGranularBodySystem() const;
+  /// Disable/enable collisions between two collision groups (see Geometry::addGroup; particles:
+  /// GranularBodySystem::addGroup).
+  void setEnableCollisions(uint32_t group1, uint32_t group2, bool enable);
   void setEnableCollisions(const std::string& group1, const std::string& group2, bool enable);
 
   /// Contacts of the last step, with the forces the solver applied (sensor contacts included, no force).
-  const std::vector<GeometryContact>& getContacts() const { return contacts_; }
+  const std::vector<GeometryContact>& getContacts() const;
   /// Particle contacts of the last step with their forces (dense particle indices of that step, see
-  /// ParticleContact): particle-particle, and particle-geometry (sensor contacts included, flagged).
+  /// ParticleContact): particle-particle, and particle-geometry (sensor contacts included, flagged). The
+  /// indices stay valid through the step's listeners, POST_STEP included (destroys are deferred until after
+  /// it); after the step they name that step's arrays, which a destroy may since have compacted.
   const std::vector<ParticleContact>& getParticleParticleContacts() const;
   const std::vector<ParticleContact>& getParticleGeometryContacts() const;
-  const StepStats& getStepStats() const { return stats_; }
-  const StepReport& getLastStepReport() const { return report_; }
+  const StepStats& getStepStats() const;
+  const StepReport& getLastStepReport() const;
 
  private:
-  struct Impl;
-  void runPreCollide();
-  void runCollide();
-  void runContactEvents();
-  void runPre();
-  void buildRows();
-  void solve();
-  void solveHybrid(bool finalDirect);
-  void addGeometricStiffness();
-  void buildShockOrder();
-  void integrate();
-  void runPost();
-  void storeContactResults();
-  void checkFinite();
-  void projectPositions();
-  void reportSeparated(const Constraint& c, Real drift);
-  bool computeGeometricStiffness();
-  int solverIndex(const RigidBody* b) const;
-
-  Real h_ = 1.0 / 60.0;
-  Vec3 gravity_{0, 0, -9.80665};
-  Real time_ = 0;
-  std::vector<RigidBodyRef> bodies_;
-  std::vector<GeometryRef> staticGeoms_;
-  std::vector<ConstraintRef> constraints_;
-  std::vector<StepEventListenerRef> stepListeners_;
-  std::vector<ContactEventListenerRef> contactListeners_;
-  std::vector<ModelRef> models_;
-  MaterialManager materials_;
-  Solver solver_;
-  Space space_;
-  GranularBodySystem granular_;
-  std::vector<GeometryContact> contacts_;
-  StepStats stats_;
-  StepReport report_;
-  std::unique_ptr<Impl> impl_;
+  // Everything the stages share (solver/src/simulation_state.h); the stages are free functions in
+  // scree::detail (solver/src/step_stages.h).
+  std::unique_ptr<detail::SimulationState> s_;
 };
 
 }  // namespace scree

@@ -1,0 +1,65 @@
+// Contact rows and their warm-start cache (solver-private; built by contact_rows.cpp, read back by
+// store_results.cpp).
+//
+// Row layout of one solved GeometryContact: [friction and rolling rows of all its points][its normal rows], so
+// the PGS sweeps meet a contact's tangents next to each other and its normals last. Each enabled point gets a
+// normal row (contact_law.h), two friction rows when mu > 0 (the friction model decides box, scaled box or
+// projected cone) and two rolling-resistance rows when the material has a rolling coefficient.
+//
+// Warm start: the impulses of last step's points, keyed by (geometry pair, narrowphase feature id), start
+// this step's rows; the cache also carries the approach speed of a speculative stop (the impact memory of the
+// contact law).
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "scree/core/math.h"
+
+namespace scree::detail {
+
+/// A contact point and its rows.
+struct PointRows {
+  uint32_t contact, point;
+  int32_t normal, t1;  // t1 = -1: no friction rows; t2 = t1 + 1
+  Vec3 tangent1, tangent2;
+  Real impactSpeed;
+};
+
+/// The row range and solver bodies of one solved contact or constraint (the couplings of the shock order).
+struct CouplingRange {
+  int32_t ia, ib;
+  uint32_t begin, count;
+  bool joint;
+};
+
+class WarmStartCache {
+ public:
+  struct Entry {
+    uint64_t pair;
+    uint32_t feature;
+    Real normal;
+    Vec3 friction;
+    Real impactSpeed;
+    bool operator<(const Entry& o) const { return pair != o.pair ? pair < o.pair : feature < o.feature; }
+  };
+  const Entry* find(uint64_t pair, uint32_t feature) const {
+    const Entry key{pair, feature, 0, Vec3::Zero(), 0};
+    auto it = std::lower_bound(current_.begin(), current_.end(), key);
+    if (it != current_.end() && it->pair == pair && it->feature == feature) return &*it;
+    return nullptr;
+  }
+  /// Collect this step's entries with add(), then commit() makes them the cache the next step reads.
+  void beginStore() { next_.clear(); }
+  void add(const Entry& e) { next_.push_back(e); }
+  void commit() {
+    std::sort(next_.begin(), next_.end());
+    std::swap(current_, next_);
+  }
+
+ private:
+  std::vector<Entry> current_, next_;
+};
+
+}  // namespace scree::detail

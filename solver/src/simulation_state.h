@@ -1,0 +1,117 @@
+// The state of a Simulation shared by the stages of its step (solver-private). Simulation (simulation.cpp)
+// owns one and keeps membership in it; each stage (step_stages.h) reads and writes only the parts named for
+// it below. Grouped by stage so that a reader can see which stage owns which buffer; every buffer is reused
+// from step to step (cleared, never reallocated once large enough).
+#pragma once
+
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include "body_access.h"
+#include "contact_rows.h"
+#include "granular_stage.h"
+#include "scree/collide/particle_collider.h"
+#include "scree/collide/space.h"
+#include "scree/solver/direct.h"
+#include "scree/solver/pgs.h"
+#include "scree/solver/simulation.h"
+
+namespace scree::detail {
+
+struct SimulationState {
+  // ---- settings and membership (Simulation's public API) ---------------------------------------------------
+  Real h = 1.0 / 60.0;
+  Vec3 gravity{0, 0, -9.80665};
+  Real time = 0;
+  std::vector<RigidBodyRef> bodies;
+  std::vector<std::vector<Geometry*>> registered;  // geometries of each body known to the space
+  std::vector<GeometryRef> staticGeoms;
+  std::vector<ConstraintRef> constraints;
+  std::vector<StepEventListenerRef> stepListeners;
+  std::vector<ContactEventListenerRef> contactListeners;
+  std::vector<ModelRef> models;  ///< Simulation::add(ModelRef) (solver/src/model.cpp)
+  MaterialManager materials;
+  Solver solver;
+  Space space;
+  GranularBodySystem granular;
+
+  // ---- outputs of the step ---------------------------------------------------------------------------------
+  std::vector<GeometryContact> contacts;  // collide -> events -> rows -> store results
+  StepStats stats;
+  StepReport report;
+
+  // ---- collide (particles) -------------------------------------------------------------------------------
+  ParticleCollider particleCollider;
+  uint64_t particleSteps = 0;             // steps with particles, for the periodic locality reorder
+  std::vector<ParticleGeometrySide> particleGeometrySides;  // per particle-geometry contact, for the rows
+  std::vector<GeometryRef> particleGeometries;  // geometries the particles may touch, when they have groups
+  bool granularStep = false;              // the particle system is in this step (its destroys are deferred)
+
+  // ---- contact events --------------------------------------------------------------------------------------
+  // Touching pairs of the last step (sorted) with their geometries, for impact/separation events.
+  std::vector<std::pair<uint64_t, std::pair<Geometry*, Geometry*>>> prevPairs, curPairs;
+
+  // ---- forces: per body (index = position in bodies) ------------------------------------------------------
+  std::vector<SolverBodyState> sb;        // free velocities in, solved velocities out
+  std::vector<Vec3> vStart, wStart;       // velocities at the start of the step (contact rows read them)
+  std::vector<Vec3> savedX;               // last finite pose (finiteness check restores it)
+  std::vector<Quat> savedQ;
+
+  // ---- rows ------------------------------------------------------------------------------------------------
+  std::vector<ConstraintRow> rows;        // contact rows first, then constraint rows
+  std::vector<PointRows> pointRows;       // contact point -> its rows
+  WarmStartCache warmStart;
+  std::vector<CouplingRange> couplings;   // row range and bodies of each contact and constraint (shock order)
+  struct ConstraintRange {
+    Constraint* c;
+    uint32_t begin, count;
+  };
+  std::vector<ConstraintRange> ranges;
+  std::vector<int> rowDofs;
+  bool nonIterativeRows = false;          // some row's solve type is not ITERATIVE
+  bool warnedSolveType = false;
+  std::unordered_set<const Constraint*> reportedSeparated;  // separated constraints already logged
+  GranularStage particles;
+
+  // ---- solve -----------------------------------------------------------------------------------------------
+  DirectSolver direct;
+  std::vector<uint32_t> directSet, iterSet;
+  bool pureIterative = false;             // some row is only in the iterative set
+  std::vector<Real> geomK;                // geometric stiffness per body (geometric_stiffness.cpp)
+  // Shock ordering (shock_order.cpp).
+  std::vector<int> level;                 // support level per body: 0 static/kinematic, 1 touches those, ...
+  std::vector<std::vector<uint32_t>> adjacency;
+  std::vector<PgsSolver::ShockRange> shock;
+  std::vector<uint32_t> frontier;
+  std::vector<std::pair<int, uint32_t>> order;
+
+  // ---- position projection: its own direct solver, so each keeps its cached symbolic analysis ---------------
+  DirectSolver projector;
+  std::vector<ConstraintRow> projRows;
+  std::vector<int> projDofs;
+  std::vector<uint32_t> projSet;
+  std::vector<SolverBodyState> projBodies;
+
+  /// Index of b in bodies (the solver body index), -1 when b is null or not in this simulation.
+  int solverIndex(const RigidBody* b) const {
+    if (!b) return -1;
+    const int i = BodyAccess::simIndex(const_cast<RigidBody&>(*b));
+    return (i >= 0 && size_t(i) < bodies.size() && bodies[size_t(i)].get() == b) ? i : -1;
+  }
+  /// The solver statistics the stages write (Solver exposes them read-only).
+  SolverStats& solverStats();
+};
+
+/// Key of a geometry contact's pair (ids of geometry 0 and 1): events and the warm-start cache use it.
+inline uint64_t contactPairKey(const GeometryContact& c) {
+  return (uint64_t(c.geometry(0)->getId()) << 32) | c.geometry(1)->getId();
+}
+
+/// The stages' write access to Solver's statistics.
+struct SolverStatsWriter {
+  static SolverStats& of(Solver& solver) { return solver.stats_; }
+};
+inline SolverStats& SimulationState::solverStats() { return SolverStatsWriter::of(solver); }
+
+}  // namespace scree::detail

@@ -1,0 +1,203 @@
+// Solve stage: the velocity solve of this step's rows and particle contact units, by one of four paths
+// chosen from what the step holds (DESIGN.md §2 step 7, §4):
+//
+//   path         when                                          what runs
+//   NOTHING      no rows, no particle units                    nothing
+//   HYBRID       some row in the direct set (DIRECT, SPLIT,    hybrid direct/iterative rounds on the rows, then
+//                DIRECT_AND_ITERATIVE; needs SuiteSparse)      the iterative particle units swept against it
+//   INTERLEAVED  rigid rows, and particles touching a          one rigid PGS sweep and one particle sweep per
+//                dynamic body                                  iteration, so each side sees the other's impulses
+//   ITERATIVE    otherwise                                     rigid PGS sweeps, then particle sweeps
+//
+// Every path but NOTHING starts from the warm start (PgsSolver::prepare, GranularStage::prepare) and ends with
+// the shock passes (Solver::setUseShockPropagation). Particle units in the manual's DIRECT mode become rows on
+// appended solver bodies for the HYBRID path (granular_stage.h) and are removed again after it.
+#include <algorithm>
+
+#include "scree/core/logger.h"
+#include "step_stages.h"
+
+namespace scree::detail {
+
+namespace {
+
+enum class SolvePath { NOTHING, HYBRID, INTERLEAVED, ITERATIVE };
+
+bool hasParticleUnits(const SimulationState& s) { return s.granularStep && s.particles.hasUnits(); }
+
+SolvePath choosePath(const SimulationState& s) {
+  if (s.rows.empty() && !hasParticleUnits(s)) return SolvePath::NOTHING;
+  if (!s.directSet.empty()) return SolvePath::HYBRID;
+  if (hasParticleUnits(s) && s.particles.coupled() && !s.rows.empty()) return SolvePath::INTERLEAVED;
+  return SolvePath::ITERATIVE;
+}
+
+/// Direct set: DIRECT rows; SPLIT and DIRECT_AND_ITERATIVE rows except friction. The iterative set: the rest,
+/// and DIRECT_AND_ITERATIVE rows too (after their direct solve). Returns true when SPLIT friction needs the
+/// final direct solve of the normals. Scenes whose rows are all ITERATIVE skip the classification.
+bool classifyRows(SimulationState& s, bool particleDirect) {
+  s.directSet.clear();
+  s.iterSet.clear();
+  s.pureIterative = false;
+  bool split = false;
+  if (!DirectSolver::available() || !(s.nonIterativeRows || particleDirect)) return false;
+  for (uint32_t i = 0; i < s.rows.size(); ++i) {
+    const ConstraintRow& r = s.rows[i];
+    const auto t = r.solveType;
+    const bool direct = t == FrictionModel::DIRECT || (t != FrictionModel::ITERATIVE && !r.friction);
+    if (direct) s.directSet.push_back(i);
+    if (!direct || t == FrictionModel::DIRECT_AND_ITERATIVE) s.iterSet.push_back(i);
+    s.pureIterative |= !direct;
+    split |= t == FrictionModel::SPLIT && r.friction;
+  }
+  return split;
+}
+
+bool useShock(const SimulationState& s) { return s.solver.getUseShockPropagation(); }
+
+/// Particle shock pass (GranularStage::shockPass) along gravity; none without gravity.
+void particleShock(SimulationState& s) {
+  if (useShock(s) && s.gravity.squaredNorm() > 0)
+    s.particles.shockPass(s.granular, s.sb, -s.gravity.normalized(), 2);
+}
+
+/// Rigid shock pass over the support order; with onlyIterative, couplings with a non-ITERATIVE row are skipped
+/// (their rows are the direct solve's).
+void rigidShock(SimulationState& s, bool onlyIterative) {
+  if (!useShock(s) || s.couplings.empty()) return;
+  buildShockOrder(s);
+  auto& sh = s.shock;
+  if (onlyIterative)
+    sh.erase(std::remove_if(sh.begin(), sh.end(),
+                            [&](const PgsSolver::ShockRange& r) {
+                              for (uint32_t i = r.begin; i < r.begin + r.count; ++i)
+                                if (s.rows[i].solveType != FrictionModel::ITERATIVE) return true;
+                              return false;
+                            }),
+             sh.end());
+  if (!sh.empty()) PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations());
+}
+
+/// One direct solve of the direct set with every other row's impulse held; PGS finishes the set on failure.
+void directSolve(SimulationState& s) {
+  SolverStats& st = s.solverStats();
+  DirectSolver::Settings ds;
+  ds.form = s.solver.getDirectForm();
+  ds.maxPivots = s.solver.getMaxPivots();
+  const DirectSolver::Result r = s.direct.solve(s.rows, s.directSet, s.sb, ds);
+  st.numFactorisations += size_t(r.factorisations);
+  st.numPivots += size_t(r.pivots);
+  st.numSymbolicAnalyses += size_t(r.symbolicAnalyses);
+  st.factorisationTime += r.factorSeconds;
+  st.directForm = int(r.form);
+  st.complementarityResidual = r.residual;
+  if (!r.converged) {
+    st.directFallback = true;
+    Logger::warningOnce("scree.direct.fallback",
+                        "DIRECT solver: no solution within the pivot cap (Solver::setMaxPivots) or the matrix "
+                        "was not definite; the direct rows of such steps are finished by PGS "
+                        "(SolverStats::directFallback)");
+    st.complementarityResidual = PgsSolver::iterate(s.rows, s.sb, s.solver.getNumIterations(), s.directSet);
+  }
+}
+
+/// HYBRID (DESIGN.md §4): direct solve of the direct set with the iterative rows' impulses held, then PGS
+/// sweeps over the iterative set with the direct impulses held, numHybridRounds times; SPLIT friction ends
+/// with one more direct solve of the normals. The rigid shock pass visits only couplings whose rows are all
+/// iterative. Then the iterative particle units are swept with the rows' impulses held.
+void hybridPath(SimulationState& s, bool finalDirect, bool particleDirect) {
+  SolverStats& st = s.solverStats();
+  st.numDirectRows = s.directSet.size();
+  st.numIterativeRows = s.pureIterative ? s.iterSet.size() : 0;
+  // Without rows that only PGS solves, there is nothing to alternate with: one direct solve.
+  if (!s.pureIterative) s.iterSet.clear();
+  const int rounds = s.iterSet.empty() ? 1 : s.solver.getNumHybridRounds();
+  const int sweeps = std::max(1, (s.solver.getNumIterations() + rounds - 1) / rounds);
+  st.numIterations = 0;
+  st.lastResidual = 0;
+  for (int round = 0; round < rounds; ++round) {
+    directSolve(s);
+    if (s.iterSet.empty()) break;
+    st.lastResidual = PgsSolver::iterate(s.rows, s.sb, sweeps, s.iterSet);
+    st.numIterations += size_t(sweeps);
+  }
+  if (!s.iterSet.empty()) rigidShock(s, true);
+  if (finalDirect) directSolve(s);
+
+  if (particleDirect) {
+    s.particles.finishDirect(s.granular, s.rows, s.sb);
+    // The particle rows are gone again: keep the direct set valid for the position projection (ascending).
+    while (!s.directSet.empty() && s.directSet.back() >= s.rows.size()) s.directSet.pop_back();
+  }
+  Real residual = st.lastResidual;
+  if (hasParticleUnits(s) && s.particles.hasIterativeUnits()) {
+    const int iterations = s.solver.getNumIterations();
+    for (int it = 0; it < iterations; ++it)
+      residual = std::max(residual, s.particles.sweep(s.granular, s.sb, it % 2 == 1));
+    particleShock(s);
+  }
+  st.lastResidual = residual;
+}
+
+/// INTERLEAVED and ITERATIVE: PGS sweeps over all rows and particle units, then the shock passes.
+void iterativePath(SimulationState& s, bool interleaved) {
+  SolverStats& st = s.solverStats();
+  const int iterations = s.solver.getNumIterations();
+  const bool particles = hasParticleUnits(s);
+  st.numIterativeRows = s.rows.size();
+  Real residual = 0;
+  if (interleaved) {
+    for (int it = 0; it < iterations; ++it) {
+      residual = PgsSolver::iterate(s.rows, s.sb, 1);
+      residual = std::max(residual, s.particles.sweep(s.granular, s.sb, it % 2 == 1));
+    }
+  } else {
+    if (!s.rows.empty()) residual = PgsSolver::iterate(s.rows, s.sb, iterations);
+    if (particles)
+      for (int it = 0; it < iterations; ++it)
+        residual = std::max(residual, s.particles.sweep(s.granular, s.sb, it % 2 == 1));
+  }
+  if (particles) particleShock(s);
+  st.lastResidual = residual;
+  st.numIterations = size_t(iterations);
+  if (!s.rows.empty()) rigidShock(s, false);
+}
+
+}  // namespace
+
+void solve(SimulationState& s) {
+  SolverStats& st = s.solverStats();
+  st.numDirectRows = st.numIterativeRows = st.numFactorisations = st.numPivots = st.numSymbolicAnalyses = 0;
+  st.complementarityResidual = 0;
+  st.factorisationTime = 0;
+  st.directFallback = false;
+  s.directSet.clear();
+  s.iterSet.clear();
+  if (choosePath(s) == SolvePath::NOTHING) {
+    st.numIterations = 0;
+    st.lastResidual = 0;
+    return;
+  }
+  // DIRECT-mode particle units become rows on appended solver bodies (warm start first: the appended bodies
+  // copy the particle velocities), so they are classified and solved like rigid rows.
+  const bool particles = hasParticleUnits(s);
+  const bool particleDirect = particles && s.particles.hasDirectUnits();
+  if (particleDirect) {
+    s.particles.prepare(s.granular, s.sb);
+    s.particles.appendDirectRows(s.granular, s.rows, s.sb);
+  }
+  const bool split = classifyRows(s, particleDirect);
+  if (!s.directSet.empty()) addGeometricStiffness(s);
+  if (!s.rows.empty()) PgsSolver::prepare(s.rows, s.sb);
+  if (particleDirect) s.particles.loadDirectImpulses(s.rows);
+  else if (particles) s.particles.prepare(s.granular, s.sb);
+
+  switch (choosePath(s)) {
+    case SolvePath::NOTHING: break;
+    case SolvePath::HYBRID: hybridPath(s, split, particleDirect); break;
+    case SolvePath::INTERLEAVED: iterativePath(s, true); break;
+    case SolvePath::ITERATIVE: iterativePath(s, false); break;
+  }
+}
+
+}  // namespace scree::detail

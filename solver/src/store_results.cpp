@@ -1,0 +1,33 @@
+// Store-results stage: the solved impulses become the contact points' forces and next step's warm start, the
+// constraints' results (Constraint::storeResult) and the particle contacts' forces.
+#include "step_stages.h"
+
+namespace scree::detail {
+
+void storeResults(SimulationState& s) {
+  const Real invH = 1.0 / s.h;
+  s.warmStart.beginStore();
+  for (const PointRows& pr : s.pointRows) {
+    GeometryContact& c = s.contacts[pr.contact];
+    ContactPoint& p = c.points()[pr.point];
+    const Real ln = s.rows[pr.normal].lambda;
+    Vec3 ft = Vec3::Zero();
+    if (pr.t1 >= 0) ft = s.rows[pr.t1].lambda * pr.tangent1 + s.rows[pr.t1 + 1].lambda * pr.tangent2;
+    p.normalImpulse = ln;
+    p.frictionImpulse = ft;
+    p.normalForce = ln * invH;
+    p.frictionForce = ft * invH;
+    p.impactSpeed = pr.impactSpeed;
+    s.warmStart.add({contactPairKey(c), p.featureId, ln, ft, pr.impactSpeed});
+  }
+  s.warmStart.commit();
+  for (const auto& r : s.ranges) r.c->storeResult(s.rows.data() + r.begin, s.rowDofs.data() + r.begin, r.count, s.h);
+  if (s.granularStep) {
+    const ParticleContactLists lists{&s.particleCollider.getParticleParticleContacts(),
+                                     &s.particleCollider.getParticleGeometryContacts(), &s.particleGeometrySides,
+                                     s.particleCollider.getCellSize()};
+    s.particles.storeResults(s.granular, lists, s.h);
+  }
+}
+
+}  // namespace scree::detail
