@@ -87,6 +87,7 @@ void Terrain::init() {
   contactListener_->setFilter(std::make_shared<GeometryFilter>(geometry_.get()));
   stepListener_ = std::make_shared<StepListener>(this);
   load_.assign(nx_ * ny_, 0.0);
+  stiffness_.assign(nx_ * ny_, 0.0);
   loaded_.reserve(64);
   ledger_.heightField = computeHeightFieldVolume();
   heightField_->clearDirtyRectangle();
@@ -255,6 +256,27 @@ bool Terrain::pressVertex(size_t x, size_t y, Real depth) {
   return true;
 }
 
+namespace {
+/// The implicit yield of one vertex (terrain.h): the dz >= 0 with  p0 A min(m e^(a dz), M) + K dz = F, i.e. the
+/// vertex sinks until the force its contacts still carry (F - K dz, the springs relaxed by dz with the bodies
+/// held) equals the yield force of the compressed ground. a = (d+1) ln(M) / D. The left side is increasing and
+/// convex below the cap, so Newton from an upper bound converges monotonically.
+Real yieldDepth(Real F, Real K, Real p0A, Real m, Real M, Real a) {
+  const Real dzCap = std::log(M / m) / a;  // where the multiplier reaches M (>= 0)
+  if (p0A * M + K * dzCap <= F) return (F - p0A * M) / K;  // bearing failure: only the springs hold back
+  Real dz = std::min(dzCap, std::log(F / (p0A * m)) / a);   // the rigid-contact answer (K = 0) bounds it
+  if (K > 0) dz = std::min(dz, F / K);
+  for (int it = 0; it < 30; ++it) {
+    const Real e = p0A * m * std::exp(a * dz);
+    const Real g = e + K * dz - F, dg = a * e + K;
+    const Real next = dz - g / dg;
+    if (!(next < dz)) break;  // converged (monotone from above)
+    dz = std::max<Real>(0, next);
+  }
+  return dz;
+}
+}  // namespace
+
 void Terrain::postStep() {
   const auto t0 = Clock::now();
   lastContactTime_ = contactTimeAccum_;
@@ -264,11 +286,13 @@ void Terrain::postStep() {
   Simulation* sim = getSimulation();
   if (!sim) return;
 
-  // 1. Gather each contact point's normal load (along the field's +z) onto the vertices of its triangle.
+  // 1. Gather each contact point's normal load (along the field's +z) and normal stiffness (the point's Young's
+  //    modulus, N/m) onto the vertices of its triangle, by barycentric weights.
   const Transform& T = geometry_->getTransform();
   for (const GeometryContact& c : sim->getContacts()) {
     const int self = c.geometry(0) == geometry_.get() ? 0 : (c.geometry(1) == geometry_.get() ? 1 : -1);
     if (self < 0 || !c.isEnabled() || c.isSensor()) continue;
+    const Real Ec = c.material().getYoungsModulus();
     for (const ContactPoint& p : c.points()) {
       if (!p.enabled || !(p.normalForce > 0)) continue;
       // The normal points from geometry 1 to geometry 0; the terrain is pressed along -normal when it is 1.
@@ -278,21 +302,23 @@ void Terrain::postStep() {
       size_t v[3];
       Real w[3];
       if (!locate(T.applyInverse(p.point), v, w)) continue;
+      const Real E = p.youngsModulus > 0 ? p.youngsModulus : Ec;
       for (int k = 0; k < 3; ++k) {
         if (!(w[k] > 0)) continue;
         if (load_[v[k]] == 0) loaded_.push_back(v[k]);
         load_[v[k]] += w[k] * load;
+        stiffness_[v[k]] += w[k] * E;
       }
     }
   }
   numLoaded_ = loaded_.size();
 
-  // 2. Yield: lower each overloaded deformable vertex to the depth where p0 m carries its pressure (terrain.h).
+  // 2. Yield: lower each overloaded deformable vertex (terrain.h).
   TerrainDataInterface& di = *data_;
   const Real M = di.maxMultiplier_, D = di.depthForMax_, p0 = di.yieldPressure_, maxChange = di.maxChange_;
-  const Real invArea = 1 / (dx_ * dy_);
+  const Real area = dx_ * dy_;
   if (M > 1 && maxChange > 0 && !loaded_.empty()) {
-    const Real log2M = std::log2(M);
+    const Real log2M = std::log2(M), lnM = std::log(M);
     // Batches of nearby edits: one bounds update per batch, over the batch's tiles only. A new batch starts
     // when a vertex lies more than two tiles away from the current one (wheels far apart stay separate).
     const size_t span = 2 * HeightField::kTileSize;
@@ -303,19 +329,20 @@ void Terrain::postStep() {
       if (!(d > 0)) continue;
       const size_t x = v % nx_, y = v / nx_;
       if (lockedBorders_ && isBorderVertex(x, y)) continue;
-      const Real m = di.multiplier_[v];
-      const Real pv = load_[v] * invArea;
-      if (!(pv > p0 * m)) continue;
-      Real mt = std::min(pv / p0, m + maxChange);
-      const Real dc = std::log2(mt / m) / (d + 1);
-      const Real dz = D * dc / log2M;
+      const Real m = di.multiplier_[v], F = load_[v];
+      if (!(F > p0 * area * m)) continue;
+      const Real a = (d + 1) * lnM / D;
+      Real dz = yieldDepth(F, stiffness_[v], p0 * area, m, M, a);
+      // The per-step bound on the multiplier's growth bounds the depth too (also in bearing failure).
+      if (std::isfinite(maxChange)) dz = std::min(dz, std::log((m + maxChange) / m) / a);
       if (!(dz > 0)) continue;
-      // The stored multiplier is the formula at the new c, except that rounding may not push it past m +
-      // maxChange (the per-step bound is exact).
+      const Real dc = dz * log2M / D;
       const Real cMax = log2M / (d + 1);
       const Real cNew = std::min(di.compression_[v] + dc, std::max(di.compression_[v], cMax));
-      mt = std::min(TerrainDataInterface::multiplier(cNew, d, M), m + maxChange);
-      while (mt - m > maxChange) mt = std::nextafter(mt, Real(0));  // exact as read back: m_new - m <= maxChange
+      // The stored multiplier is the formula at the new c, except that rounding may not push it past m +
+      // maxChange (the per-step bound is exact as read back).
+      Real mt = std::min(TerrainDataInterface::multiplier(cNew, d, M), m + maxChange);
+      while (mt - m > maxChange) mt = std::nextafter(mt, Real(0));
       if (open && (std::max(batch.i1, x) - std::min(batch.i0, x) > span ||
                    std::max(batch.j1, y) - std::min(batch.j0, y) > span)) {
         heightField_->endHeightEdit();
@@ -335,7 +362,7 @@ void Terrain::postStep() {
     // Our own edits are booked already; clearing lets the next step tell external edits apart.
     heightField_->clearDirtyRectangle();
   }
-  for (size_t v : loaded_) load_[v] = 0;
+  for (size_t v : loaded_) load_[v] = stiffness_[v] = 0;
   loaded_.clear();
   lastPostTime_ = secondsSince(t0);
 }

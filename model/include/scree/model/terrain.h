@@ -37,24 +37,35 @@
 //
 // Yield (how far a loaded vertex sinks in a step). After the solve (post step), each contact point's normal
 // force on the terrain, projected on the field's +z, is split onto the three vertices of the height-field
-// triangle under the point by its barycentric weights: F_v. The vertex pressure is p_v = F_v / (dx dy). Loose
-// soil yields at p0 (the yield pressure); a vertex with multiplier m yields at p_y = p0 m. If p_v > p_y the
-// vertex is lowered by exactly the dz that raises m to the target
-//     m_t = min(p_v / p0, m + maxChange)          (maxChange: the max Young's change per time step)
-//     dz  = D log2(m_t / m) / ((d+1) log2(M))
-// and c grows by dz log2(M) / D (capped at c_max). So a vertex yields until the ground under it carries the
-// pressure (p0 m = p_v), the multiplier never grows by more than maxChange in a step, and maxChange = 0 freezes
-// the ground. Unloading changes nothing: the vertex keeps c, so a second pass at the same load meets ground that
-// already carries it and only deflects elastically (the contact's stiffness is E m).
+// triangle under the point by its barycentric weights: F_v; the points' normal stiffnesses (their Young's
+// moduli E, N/m) are split the same way: K_v. The vertex pressure is p_v = F_v / A, A = dx dy. Loose soil yields
+// at p0 (the yield pressure); a vertex with multiplier m yields at p_y = p0 m. If p_v > p_y the vertex is
+// lowered by the dz that solves
+//     p0 A m(c + dz log2(M) / D) + K_v dz = F_v                       (implicit: a return mapping)
+// i.e. it sinks until the force its contacts still carry once they relax by dz (F_v - K_v dz, the bodies held
+// for the step) equals the yield force of the ground made harder by that sinking. The bodies then follow under
+// their loads and the next steps continue, so a steady load ends where p0 m = p_v: the settled state is the
+// one of "lower by exactly the dz that brings p_y up to p_v". Why not that explicit rule itself: a vertex that
+// sinks dz sheds K dz of load onto its neighbours, and sinking by the full target makes the load exchange of
+// neighbouring vertices under one body an iteration with gain K D / ((d+1) ln(M) F) - about 70 for a 52 N point
+// with K = 1e5 N/m - which diverges (gain > 2): the ground under a plate or a wheel breaks into pits and
+// spikes. The implicit rule never sheds more than the load (dz <= F_v / K_v, the contact's elastic
+// deflection), so its updates are stable. Consequence: a vertex yields at most the elastic deflection
+// F / (E m) of its contacts per step - give soil contacts a soil-like Young's modulus (per contact point, e.g.
+// 1e5-1e6 N/m for centimetres of sinkage in a second); with stiff contacts (the 4e8 default) the ground
+// compresses by micrometres per step.
+// Bounds: the multiplier may grow by at most maxChange (the max Young's change per time step) in one step,
+// which bounds dz too (maxChange = 0 freezes the ground); c is capped at c_max. Unloading changes nothing: the
+// vertex keeps c, so a second pass at the same load meets ground that already carries it and only deflects
+// elastically (the contact's stiffness is E m).
 //
 // Settled sinkage of a flat plate. Under a uniform pressure p on loose, level soil every vertex settles where
 // p0 m = p, i.e. at depth
 //     z* = D ln(p / p0) / ((d+1) ln M)         for p0 < p <= p0 M      (0 for p <= p0),
 // finite, growing with load (logarithmically), falling as 1/(d+1) with deformability. Above p0 M (c at c_max,
-// m = M) nothing balances the load: bearing failure - the vertex keeps sinking every step it is loaded, by
-// D log2(min(p / p0, M + maxChange) / M) / ((d+1) log2 M) per step (with maxChange = +infinity: the depth the
-// excess would need if the ground could keep hardening). The plastic sinkage is the height lost; the body rests
-// an elastic F_v / (E m) deeper.
+// m = M) nothing balances the load: bearing failure - the vertex keeps sinking every step it is loaded, by the
+// elastic excess (F_v - p0 A M) / K_v per step (and at most D log2(1 + maxChange / M) / ((d+1) log2 M)). The
+// plastic sinkage is the height lost; the body rests an elastic F_v / (E m) deeper.
 //
 // Contact stiffness. A contact listener (contacts of any geometry with the terrain geometry) sets each point's
 // Young's modulus to E * m, m interpolated barycentrically from the three vertices under the point, E the
@@ -185,6 +196,7 @@ class Terrain : public Model {
   mutable TerrainVolumeLedger ledger_;
   // Sparse per-step load gathering: load_ is dense (zero between steps), loaded_ lists the vertices written.
   std::vector<Real> load_;
+  std::vector<Real> stiffness_;  ///< N/m: barycentric share of the contact points' Young's moduli
   std::vector<size_t> loaded_;
   size_t numLoaded_ = 0, numYielded_ = 0;
   double lastContactTime_ = 0, lastPostTime_ = 0;
