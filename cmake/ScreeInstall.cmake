@@ -11,7 +11,8 @@
 #   Scree::scree_options  the project's own warning/sanitizer flags; consumers do not get it through
 #                         Scree::scree (modules link it PRIVATE through $<BUILD_INTERFACE:...>).
 # Static module libraries carry their private dependencies as $<LINK_ONLY:...> (CCD::CCD,
-# SuiteSparse::CHOLMOD); ScreeConfig.cmake finds them with the find modules installed beside it.
+# SuiteSparse::CHOLMOD, PNG::PNG); ScreeConfig.cmake finds them with the find modules installed beside it
+# (PNG with CMake's own FindPNG).
 include(CMakePackageConfigHelpers)
 
 set(SCREE_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/Scree" CACHE STRING

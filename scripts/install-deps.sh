@@ -14,7 +14,7 @@
 # (non-Debian systems with the dependencies installed by other means).
 set -euo pipefail
 
-packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libccd-dev doctest-dev libbenchmark-dev)
+packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libccd-dev libpng-dev doctest-dev libbenchmark-dev)
 check_only=0
 for arg in "$@"; do
   case "$arg" in
