@@ -10,10 +10,7 @@
 #include "scree/model/terrain.h"
 #include "scree/solver/simulation.h"
 
-#if __has_include("png_index_map.h")
 #include "png_index_map.h"
-#define SCREE_TERRAIN_HAVE_PNG 1
-#endif
 
 namespace scree {
 
@@ -52,7 +49,6 @@ MaterialRef TerrainDataInterface::defaultMaterial() const { return terrain_.defa
 // --- material map ----------------------------------------------------------------------------------------------
 
 void TerrainDataInterface::setMaterialMapping(const std::string& filePath) {
-#ifdef SCREE_TERRAIN_HAVE_PNG
   // Read and check everything before touching the map, so a bad file leaves it unchanged.
   const detail::PngIndexMap img = detail::readPngIndexMap(filePath);
   if (img.width != nx_ || img.height != ny_)
@@ -66,10 +62,6 @@ void TerrainDataInterface::setMaterialMapping(const std::string& filePath) {
     std::copy_n(img.index.begin() + std::ptrdiff_t(row * nx_), nx_, index_.begin() + std::ptrdiff_t(y * nx_));
   }
   refreshMultipliers();
-#else
-  throw std::invalid_argument(where("setMaterialMapping") + ": \"" + filePath +
-                              "\" cannot be read (this build has no PNG reader)");
-#endif
 }
 
 void TerrainDataInterface::setMaterialMapping(size_t x, size_t y, size_t materialIndex) {
