@@ -224,4 +224,29 @@ TEST_SUITE("terrain") {
     CHECK(sunk > 0);
     MESSAGE(sunk << " of 81 inner vertices sank; borders untouched");
   }
+
+  TEST_CASE("the ledger: trapezoid weights, incremental through compression, direct height edits booked once") {
+    TestWorld w;
+    TerrainRef t = addFlatTerrain(w, 5, 4.0, 1.0);  // 1 m cells, 4 x 4 m^2 of 1 m thick soil: 16 m^3
+    CHECK(t->getVolumeLedger().heightField == 16.0);
+    CHECK(t->getVertexArea(0, 0) == 0.25);
+    CHECK(t->getVertexArea(0, 2) == 0.5);
+    CHECK(t->getVertexArea(2, 2) == 1.0);
+    t->getDataInterface().add(w.material, 0, 0.0, 1.0);
+    CHECK(t->pressVertex(2, 2, 0.1));  // inner vertex: 0.1 m^3 from heightField to compressed
+    CHECK(t->pressVertex(0, 0, 0.2));  // corner: 0.05 m^3
+    const TerrainVolumeLedger& l = t->getVolumeLedger();
+    CHECK(l.heightField == doctest::Approx(15.85).epsilon(1e-12));
+    CHECK(l.compressed == doctest::Approx(0.15).epsilon(1e-12));
+    CHECK(l.total() == doctest::Approx(16.0).epsilon(1e-12));
+    // A direct HeightField edit is not soil the terrain moved: the account follows it, the total changes by it.
+    t->getHeightField()->setHeight(4, 2, 1.5);  // edge vertex: +0.25 m^3
+    CHECK(t->getVolumeLedger().heightField == doctest::Approx(16.1).epsilon(1e-12));
+    CHECK(t->getVolumeLedger().total() == doctest::Approx(16.25).epsilon(1e-12));
+    CHECK(t->getHeightField()->getDirtyRectangle().empty());
+    // Nothing touches the terrain: no vertex loaded, no edit, ledger constant.
+    stepCheckingLedger(w, *t, 10);
+    CHECK(t->getNumLoadedVertices() == 0);
+    CHECK(t->getVolumeLedger().heightField == t->computeHeightFieldVolume());
+  }
 }

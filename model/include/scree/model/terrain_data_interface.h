@@ -51,14 +51,15 @@ class Terrain;
 class TerrainDataInterface {
  public:
   static constexpr size_t kNumMaterialIndices = 256;
-  /// Defaults. M = 16 and D = 0.2 m with d = 1 and p0 = 7 kPa put the settled plate sinkage of the law close to
-  /// Bekker's curve for a dry sand over 10-100 kPa (docs/terrain.md, plate-sinkage study); maxChange 1 per step
-  /// lets a vertex go from loose (m = 1) to M = 16 in 15 steps, and bounds bearing-failure sinking (terrain.h).
+  /// Defaults: with d = 1 they are the rounded least-squares fit of the law's settled plate sinkage to Bekker's
+  /// curve for Wong's dry sand (LLL; b = 0.5 m) over 10-100 kPa (docs/terrain.md, plate-sinkage study): p0 = 7 kPa,
+  /// M = 16 (the smallest power of two with p0 M above 100 kPa), D = 0.12 m. maxChange 1 per step lets a vertex
+  /// go from loose (m = 1) to M = 16 in 15 steps and bounds how fast the ground hardens under a fast, deep contact.
   static constexpr Real defaultMaxCompressionMultiplier = 16;
-  static constexpr Real defaultDepthForMaxCompression = 0.2;   ///< m
+  static constexpr Real defaultDepthForMaxCompression = 0.12;  ///< m
   static constexpr Real defaultMaxYoungsChangePerTimestep = 1;  ///< multiplier units per time step
-  /// Pa. Loose, uncompressed soil (m = 1) starts to yield at this pressure; a dry sand carries a walking person
-  /// (15-25 kPa) with a few centimetres of sinkage, so its yield begins well below that (fit: ~7 kPa).
+  /// Pa. Loose, uncompressed soil (m = 1) starts to yield at this pressure (the fit above; a dry sand carries a
+  /// walking person, 15-25 kPa, with a centimetre or two of sinkage).
   static constexpr Real defaultYieldPressure = 7e3;
 
   /// Sized for the terrain's height field; all vertices unmapped (index 0, nothing registered), c = 0, m = 1.
