@@ -26,8 +26,9 @@ struct PlateResult {
 /// 0-900 N on points whose exact share is 52 N), while the yield law reads per-point forces.
 /// Contact E = 1e5 N/m per point: the soil's elastic deflection under a piston (0.5 mm at 52 N), which is also
 /// how far a vertex can yield in one step (terrain.h).
-PlateResult pressPlate(Real pressureOverP0, Real deformability, Real seconds, Real* expected = nullptr) {
-  TestWorld w;
+PlateResult pressPlate(Real pressureOverP0, Real deformability, Real seconds, Real* expected = nullptr,
+                       Real dt = 1.0 / 60) {
+  TestWorld w(dt);
   w.contactMaterial->setYoungsModulus(1e5);
   TerrainRef t = addFlatTerrain(w, 11, 0.5);
   TerrainDataInterface& di = t->getDataInterface();
@@ -89,9 +90,25 @@ TEST_SUITE("terrain") {
     CHECK(below.max == 0);
     // 20 p0 > 16 p0 = p0 M: every loaded step sinks further, past D/(d+1) where the law's range ends.
     const Real end = TerrainDataInterface::defaultDepthForMaxCompression / 2;
-    const PlateResult failing = pressPlate(20.0, 1.0, 3.0);
-    MESSAGE("20 p0: sinkage " << failing.mean << " m after 3 s (D/(d+1) = " << end << " m)");
-    CHECK(failing.min > 1.2 * end);
+    const PlateResult early = pressPlate(20.0, 1.0, 1.5), late = pressPlate(20.0, 1.0, 3.0);
+    MESSAGE("20 p0: sinkage " << early.mean << " m after 1.5 s, " << late.mean << " m after 3 s (D/(d+1) = " << end
+                              << " m)");
+    CHECK(late.min > end);
+    CHECK(late.min > early.max + 0.005);
+  }
+
+  TEST_CASE("the settled plate sinkage holds at smaller time steps") {
+    // 5 %: at 1/400 s a piston landing on ground that just yielded is stopped by a larger, shorter force
+    // (~ m v / h); the load averaging time (0.1 s) takes most of it out (without it, measured: +133 % at
+    // 3 p0 and a runaway at 10 p0), what remains is measured here.
+    for (Real dt : {1.0 / 120, 1.0 / 400})
+      for (Real ratio : {3.0, 10.0}) {
+        Real expected = 0;
+        const PlateResult r = pressPlate(ratio, 1.0, 8.0, &expected, dt);
+        MESSAGE("dt = " << dt << ", p = " << ratio << " p0: sinkage " << r.mean << " m, closed form " << expected
+                        << " m, error " << 100 * (r.mean - expected) / expected << " %");
+        CHECK(std::abs(r.mean - expected) <= 0.05 * expected);
+      }
   }
 
   TEST_CASE("a rolling wheel leaves a rut; its second pass sinks less than the first") {

@@ -88,6 +88,8 @@ void Terrain::init() {
   stepListener_ = std::make_shared<StepListener>(this);
   load_.assign(nx_ * ny_, 0.0);
   stiffness_.assign(nx_ * ny_, 0.0);
+  avgLoad_.assign(nx_ * ny_, 0.0);
+  avgStiff_.assign(nx_ * ny_, 0.0);
   loaded_.reserve(64);
   ledger_.heightField = computeHeightFieldVolume();
   heightField_->clearDirtyRectangle();
@@ -127,6 +129,11 @@ void Terrain::onAdd(Simulation& sim) {
 }
 
 void Terrain::onRemove(Simulation&) {}
+
+void Terrain::setLoadAveragingTime(Real seconds) {
+  detail::requireNonNegative("Terrain::setLoadAveragingTime", "seconds", seconds);
+  loadAveragingTime_ = seconds;
+}
 
 void Terrain::setEnableLockedBorders(bool enable, bool avalancheMassLoss) {
   lockedBorders_ = enable;
@@ -299,10 +306,10 @@ void Terrain::postStep() {
       const Real nz = T.rotateInverse(p.normal).z();
       const Real load = p.normalForce * (self == 1 ? nz : -nz);
       if (!(load > 0)) continue;
+      const Real E = p.youngsModulus > 0 ? p.youngsModulus : Ec;
       size_t v[3];
       Real w[3];
       if (!locate(T.applyInverse(p.point), v, w)) continue;
-      const Real E = p.youngsModulus > 0 ? p.youngsModulus : Ec;
       for (int k = 0; k < 3; ++k) {
         if (!(w[k] > 0)) continue;
         if (load_[v[k]] == 0) loaded_.push_back(v[k]);
@@ -312,8 +319,24 @@ void Terrain::postStep() {
     }
   }
   numLoaded_ = loaded_.size();
+  // 2. Average the load over the load averaging time (an exponential moving average per vertex; the active
+  //    list holds the vertices whose average has not decayed to zero, so an untouched terrain does no work).
+  const bool averaging = loadAveragingTime_ > sim->getTimeStep();
+  if (averaging) {
+    const Real alpha = sim->getTimeStep() / loadAveragingTime_;
+    for (size_t v : loaded_)
+      if (avgLoad_[v] == 0) active_.push_back(v);
+    size_t keep = 0;
+    for (size_t v : active_) {
+      avgLoad_[v] += alpha * (load_[v] - avgLoad_[v]);
+      avgStiff_[v] += alpha * (stiffness_[v] - avgStiff_[v]);
+      if (avgLoad_[v] > 1e-9) active_[keep++] = v;  // below a micronewton: forgotten
+      else avgLoad_[v] = avgStiff_[v] = 0;
+    }
+    active_.resize(keep);
+  }
 
-  // 2. Yield: lower each overloaded deformable vertex (terrain.h).
+  // 3. Yield: lower each overloaded deformable vertex (terrain.h).
   TerrainDataInterface& di = *data_;
   const Real M = di.maxMultiplier_, D = di.depthForMax_, p0 = di.yieldPressure_, maxChange = di.maxChange_;
   const Real area = dx_ * dy_;
@@ -329,10 +352,13 @@ void Terrain::postStep() {
       if (!(d > 0)) continue;
       const size_t x = v % nx_, y = v / nx_;
       if (lockedBorders_ && isBorderVertex(x, y)) continue;
-      const Real m = di.multiplier_[v], F = load_[v];
+      // Only vertices loaded in this step yield (a body that left stops pressing), by the averaged load.
+      const Real m = di.multiplier_[v], F = averaging ? avgLoad_[v] : load_[v];
+      const Real K = averaging ? avgStiff_[v] : stiffness_[v];
+      if (!(K > 0)) continue;
       if (!(F > p0 * area * m)) continue;
       const Real a = (d + 1) * lnM / D;
-      Real dz = yieldDepth(F, stiffness_[v], p0 * area, m, M, a);
+      Real dz = yieldDepth(F, K, p0 * area, m, M, a);
       // The per-step bound on the multiplier's growth bounds the depth too (also in bearing failure).
       if (std::isfinite(maxChange)) dz = std::min(dz, std::log((m + maxChange) / m) / a);
       if (!(dz > 0)) continue;

@@ -37,8 +37,10 @@
 //
 // Yield (how far a loaded vertex sinks in a step). After the solve (post step), each contact point's normal
 // force on the terrain, projected on the field's +z, is split onto the three vertices of the height-field
-// triangle under the point by its barycentric weights: F_v; the points' normal stiffnesses (their Young's
-// moduli E, N/m) are split the same way: K_v. The vertex pressure is p_v = F_v / A, A = dx dy. Loose soil yields
+// triangle under the point by its barycentric weights; the points' normal stiffnesses (their Young's moduli E,
+// N/m) are split the same way. Each vertex keeps the moving average of both over the load averaging time
+// (setLoadAveragingTime, 0.1 s): F_v and K_v (why: the setter's comment; a steady load is its own average). A
+// vertex loaded in this step has pressure p_v = F_v / A, A = dx dy. Loose soil yields
 // at p0 (the yield pressure); a vertex with multiplier m yields at p_y = p0 m. If p_v > p_y the vertex is
 // lowered by the dz that solves
 //     p0 A m(c + dz log2(M) / D) + K_v dz = F_v                       (implicit: a return mapping)
@@ -158,6 +160,16 @@ class Terrain : public Model {
   /// comment.
   Real computeSettledSinkage(Real pressure, Real deformability) const;
 
+  /// The yield reads each vertex's load averaged over this time (s, >= 0; an exponential moving average; at most
+  /// one step: no averaging). Why: a body that follows yielding ground lands on it with impulses ~ m v / h, one
+  /// step long, which a yield law reading single-step forces takes for load and answers by yielding more - at
+  /// small time steps a runaway. The time average of a contact force is the load it carries (momentum
+  /// balance), so averaging over a few damping times removes the impulses and keeps the settled state. Cost: a
+  /// load shorter than this time counts partly (a fast wheel compresses less; docs/terrain.md).
+  static constexpr Real defaultLoadAveragingTime = 0.1;
+  void setLoadAveragingTime(Real seconds);
+  Real getLoadAveragingTime() const { return loadAveragingTime_; }
+
   /// Vertices loaded by contacts in the last step, and how many of them yielded.
   size_t getNumLoadedVertices() const { return numLoaded_; }
   size_t getNumYieldedVertices() const { return numYielded_; }
@@ -196,6 +208,9 @@ class Terrain : public Model {
   mutable TerrainVolumeLedger ledger_;
   // Sparse per-step load gathering: load_ is dense (zero between steps), loaded_ lists the vertices written.
   std::vector<Real> load_;
+  std::vector<Real> avgLoad_, avgStiff_;  ///< load averaged over loadAveragingTime_ (N, N/m)
+  std::vector<size_t> active_;           ///< vertices with a non-zero average
+  Real loadAveragingTime_ = defaultLoadAveragingTime;
   std::vector<Real> stiffness_;  ///< N/m: barycentric share of the contact points' Young's moduli
   std::vector<size_t> loaded_;
   size_t numLoaded_ = 0, numYielded_ = 0;
