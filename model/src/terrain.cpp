@@ -324,13 +324,15 @@ void Terrain::postStep() {
   const bool averaging = loadAveragingTime_ > sim->getTimeStep();
   if (averaging) {
     const Real alpha = sim->getTimeStep() / loadAveragingTime_;
+    const Real forget = 1e-3 * data_->yieldPressure_ * dx_ * dy_;
     for (size_t v : loaded_)
       if (avgLoad_[v] == 0) active_.push_back(v);
     size_t keep = 0;
     for (size_t v : active_) {
       avgLoad_[v] += alpha * (load_[v] - avgLoad_[v]);
       avgStiff_[v] += alpha * (stiffness_[v] - avgStiff_[v]);
-      if (avgLoad_[v] > 1e-9) active_[keep++] = v;  // below a micronewton: forgotten
+      // Forgotten below 1e-3 of the smallest load that can yield (p0 A): about 1 s after a typical last contact.
+      if (avgLoad_[v] > forget) active_[keep++] = v;
       else avgLoad_[v] = avgStiff_[v] = 0;
     }
     active_.resize(keep);

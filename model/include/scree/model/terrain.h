@@ -25,7 +25,8 @@
 //
 // Depth and compression. Lowering a vertex by dz (pressed by a contact; later dug or pushed) raises c by
 //     dc = dz * log2(M) / D          (D = the depth for max compression)
-// capped at c_max(d); raising a vertex lowers c by the same rule (fresh loose soil on top; not below 0). From
+// capped at c_max(d); raising a vertex lowers c by the same rule (fresh loose soil on top; not below 0; no
+// operation of this part raises vertices - merging and avalanches will). From
 // loose soil a vertex lowered by z has m = 2^((d+1) log2(M) z / D) = M^((d+1) z / D): it reaches M at depth
 // D / (d+1) <= D, so at D and deeper every material is as hard as M allows (manual 25.1.2.3), and a larger d
 // hardens exponentially faster (25.1.2.1).
@@ -89,8 +90,9 @@
 // (recomputed over the grid once, from the field's dirty rectangle) and the total changes by their volume.
 //
 // Cost. Per step the terrain reads the simulation's contact list; with nothing touching it that is all (no pass
-// over the grid). Loaded vertices are gathered in a sparse list; height edits go through batched local
-// HeightField edits (begin/endHeightEdit), so only the touched tiles' bounds are updated.
+// over the grid). Loaded vertices are gathered in a sparse list, load averages live on a sparse active list
+// (a vertex leaves it about 1 s after its last contact), and height edits go through batched local HeightField edits
+// (begin/endHeightEdit, one batch per cluster of nearby vertices), so only the touched tiles' bounds are updated.
 #pragma once
 
 #include <chrono>
