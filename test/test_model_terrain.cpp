@@ -249,4 +249,36 @@ TEST_SUITE("terrain") {
     CHECK(t->getNumLoadedVertices() == 0);
     CHECK(t->getVolumeLedger().heightField == t->computeHeightFieldVolume());
   }
+
+  TEST_CASE("unequal spacing is accepted with a warning; a data-interface subclass can be installed") {
+    std::vector<std::string> warnings;
+    Logger::setSink([&](LogLevel level, const std::string& m) {
+      if (level == LogLevel::WARNING) warnings.push_back(m);
+    });
+    auto t = std::make_shared<Terrain>(std::make_shared<HeightField>(5, 5, 4.0, 2.0));  // 1 m x 0.5 m cells
+    Logger::setSink({});
+    REQUIRE(warnings.size() == 1);
+    CHECK(warnings[0].find("different x and y scale") != std::string::npos);
+    CHECK(t->getVertexArea(2, 2) == 0.5);
+
+    // A subclass that records what is registered (the manual lets users extend the data interface).
+    struct Recording : TerrainDataInterface {
+      using TerrainDataInterface::TerrainDataInterface;
+      std::vector<size_t> added;
+      void add(MaterialRef m, size_t index, Real adhesion, Real d, Real angle) override {
+        TerrainDataInterface::add(std::move(m), index, adhesion, d, angle);
+        added.push_back(index);
+      }
+    };
+    auto rec = std::make_unique<Recording>(*t);
+    Recording* r = rec.get();
+    t->setDataInterface(std::move(rec));
+    CHECK(&t->getDataInterface() == r);
+    t->getDataInterface().add(std::make_shared<Material>("sand"), 3, 0.0, 1.0, 0.0);
+    CHECK(r->added == std::vector<size_t>{3});
+    auto other = std::make_shared<Terrain>(std::make_shared<HeightField>(5, 5, 4.0, 4.0));
+    CHECK_THROWS_WITH_AS(t->setDataInterface(std::make_unique<TerrainDataInterface>(*other)),
+                         doctest::Contains("built for another terrain"), std::invalid_argument);
+    CHECK(t->getVolumeLedger().total() == 0);
+  }
 }
