@@ -319,8 +319,10 @@ void Terrain::postStep() {
     }
   }
   numLoaded_ = loaded_.size();
+
   // 2. Average the load over the load averaging time (an exponential moving average per vertex; the active
-  //    list holds the vertices whose average has not decayed to zero, so an untouched terrain does no work).
+  //    list holds the vertices whose average has not decayed below relevance, so an untouched terrain does no
+  //    work once the last contact's averages have faded).
   const bool averaging = loadAveragingTime_ > sim->getTimeStep();
   if (averaging) {
     const Real alpha = sim->getTimeStep() / loadAveragingTime_;
