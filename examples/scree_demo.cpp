@@ -4,7 +4,8 @@
 // ground, plus jointed mechanisms: a motor-driven arm (hinge with a speed motor and a force limit) and a six-link
 // pendulum chain on ball joints, a suction gripper pick-and-place (demo_suction.h) and a granular pile poured
 // from a nozzle (demo_granular.h). Prints a one-line summary per simulated second. Then a four-wheeled vehicle on
-// TwoBodyTireModel tires drives over a bump (demo_vehicle.h).
+// TwoBodyTireModel tires drives over a bump (demo_vehicle.h), and the same vehicle drives forward, back and forward
+// over soft ground (a deformable Terrain) and prints how much deeper its ruts get per pass (demo_terrain.h).
 //
 // Usage: scree_demo [seconds=5] [iterations=16]
 #include <cmath>
@@ -18,6 +19,7 @@
 #include "demo_vehicle.h"
 #include "demo_suction.h"
 #include "demo_granular.h"
+#include "demo_terrain.h"
 
 using namespace scree;
 
@@ -159,5 +161,6 @@ int main(int argc, char** argv) {
   std::printf("%d steps, %.3f ms/step (solve %.3f ms)\n", steps, 1000 * totalTime / steps, 1000 * solveTime / steps);
   const auto& report = sim.getLastStepReport();
   const bool vehicleOk = runVehicleDemo(std::min(seconds, 4.0));
-  return report.ok() && vehicleOk ? 0 : 1;
+  const bool terrainOk = runTerrainDemo(std::min(seconds, 5.0) / 2.5);
+  return report.ok() && vehicleOk && terrainOk ? 0 : 1;
 }

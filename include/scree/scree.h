@@ -29,4 +29,6 @@
 #include "scree/model/model.h"
 #include "scree/model/two_body_tire_model.h"
 #include "scree/model/suction_gripper.h"
+#include "scree/model/terrain.h"
+#include "scree/model/terrain_data_interface.h"
 #include "scree/version.h"

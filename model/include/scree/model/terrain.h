@@ -1,0 +1,224 @@
+// Terrain (AGX manual 25.1, agxModel::Terrain): a deformable height field. This part builds the terrain itself:
+// the material map, compression hardening under what rests on or rolls over it, locked borders, and the soil
+// volume ledger. Digging into particles and the dynamic height field with avalanches build on it.
+//
+// Construction (manual 25.1.1). Terrain(heightField) makes a static geometry for the field;
+// Terrain(geometry) takes a geometry whose shape is a HeightField. In Scree a geometry holds exactly one shape,
+// so "one height-field shape" is a type check; "no shape transform relative to the geometry" means: a geometry
+// on a body must sit at the body origin (identity local transform) - the body carries the placement; a static
+// geometry's placement is its world transform and may be anything whose +z opposes gravity. Unequal x and y
+// spacing is accepted with the height field's logged warning. Wrong geometry or a non-identity local transform
+// on a body throws std::invalid_argument. `sim.add(terrain)` installs the geometry (static case; a body's
+// geometry comes with the body), a contact listener and a post-step listener; it throws std::invalid_argument
+// and leaves the simulation unchanged when the field's +z is not against gravity (within 1e-6 in the cosine;
+// zero gravity accepts any orientation).
+//
+// ---------------------------------------------------------------------------------------------------------------
+// The compression law (manual 25.1.2.1-25.1.2.5)
+// ---------------------------------------------------------------------------------------------------------------
+// Per vertex: compression level c >= 0 and Young's modulus multiplier
+//     m(c) = 2^((d+1) c)  capped at M                       (the manual's  1/2 * 2^((d+1) c + 1))
+// d = the vertex material's deformability, M = the max compression multiplier (a power of two), so the cap is
+// reached at c_max(d) = log2(M) / (d+1). The manual's prose says the ground cannot harden when d = 0, while its
+// formula would still give 2^c: we follow the prose, d = 0 is non-deformable ground (m = 1, never yields, heights
+// untouched by contacts). M = 1 likewise cannot harden and is treated as non-deformable.
+//
+// Depth and compression. Lowering a vertex by dz (pressed by a contact; later dug or pushed) raises c by
+//     dc = dz * log2(M) / D          (D = the depth for max compression)
+// capped at c_max(d); raising a vertex lowers c by the same rule (fresh loose soil on top; not below 0; no
+// operation of this part raises vertices - merging and avalanches will). From
+// loose soil a vertex lowered by z has m = 2^((d+1) log2(M) z / D) = M^((d+1) z / D): it reaches M at depth
+// D / (d+1) <= D, so at D and deeper every material is as hard as M allows (manual 25.1.2.3), and a larger d
+// hardens exponentially faster (25.1.2.1).
+//   Why not dc = dz * c_max(d) / D (the reading first proposed): then m = 2^((d+1) c_max(d) z / D) = M^(z/D) for
+//   every d - deformability would cancel out of the law and a plate would sink as far in any material, against
+//   the manual ("harder exponentially faster with increased deformability") and against sinkage falling with
+//   deformability. Using c_max of the slowest material (d = 0) for the rate keeps D as the depth at which all
+//   materials are fully hardened, and lets d act.
+//
+// Yield (how far a loaded vertex sinks in a step). After the solve (post step), each contact point's normal
+// force on the terrain, projected on the field's +z, is split onto the three vertices of the height-field
+// triangle under the point by its barycentric weights; the points' normal stiffnesses (their Young's moduli E,
+// N/m) are split the same way. Each vertex keeps the moving average of both over the load averaging time
+// (setLoadAveragingTime, 0.1 s): F_v and K_v (why: the setter's comment; a steady load is its own average). A
+// vertex loaded in this step has pressure p_v = F_v / A, A = dx dy. Loose soil yields
+// at p0 (the yield pressure); a vertex with multiplier m yields at p_y = p0 m. If p_v > p_y the vertex is
+// lowered by the dz that solves
+//     p0 A m(c + dz log2(M) / D) + K_v dz = F_v                       (implicit: a return mapping)
+// i.e. it sinks until the force its contacts still carry once they relax by dz (F_v - K_v dz, the bodies held
+// for the step) equals the yield force of the ground made harder by that sinking. The bodies then follow under
+// their loads and the next steps continue, so a steady load ends where p0 m = p_v: the settled state is the
+// one of "lower by exactly the dz that brings p_y up to p_v". Why not that explicit rule itself: a vertex that
+// sinks dz sheds K dz of load onto its neighbours, and sinking by the full target makes the load exchange of
+// neighbouring vertices under one body an iteration with gain K D / ((d+1) ln(M) F) - about 70 for a 52 N point
+// with K = 1e5 N/m - which diverges (gain > 2): the ground under a plate or a wheel breaks into pits and
+// spikes. The implicit rule never sheds more than the load (dz <= F_v / K_v, the contact's elastic
+// deflection), so its updates are stable. Consequence: a vertex yields at most the elastic deflection
+// F / (E m) of its contacts per step - give soil contacts a soil-like Young's modulus (per contact point, e.g.
+// 1e5-1e6 N/m for centimetres of sinkage in a second); with stiff contacts (the 4e8 default) the ground
+// compresses by micrometres per step.
+// Bounds: the multiplier may grow by at most maxChange (the max Young's change per time step) in one step,
+// which bounds dz too (maxChange = 0 freezes the ground); c is capped at c_max. Unloading changes nothing: the
+// vertex keeps c, so a second pass at the same load meets ground that already carries it and only deflects
+// elastically (the contact's stiffness is E m).
+//
+// Settled sinkage of a flat plate. Under a uniform pressure p on loose, level soil every vertex settles where
+// p0 m = p, i.e. at depth
+//     z* = D ln(p / p0) / ((d+1) ln M)         for p0 < p <= p0 M      (0 for p <= p0),
+// finite, growing with load (logarithmically), falling as 1/(d+1) with deformability. Above p0 M (c at c_max,
+// m = M) nothing balances the load: bearing failure - the vertex keeps sinking every step it is loaded, by the
+// elastic excess (F_v - p0 A M) / K_v per step (and at most D log2(1 + maxChange / M) / ((d+1) log2 M)). The
+// plastic sinkage is the height lost; the body rests an elastic F_v / (E m) deeper.
+//
+// Contact stiffness. A contact listener (contacts of any geometry with the terrain geometry) sets each point's
+// Young's modulus to E * m, m interpolated barycentrically from the three vertices under the point, E the
+// contact's (or the point's earlier override). The material of the nearest of those vertices picks the contact
+// parameters: for a registered material other than the terrain geometry's own, the point's Young's modulus,
+// friction, restitution and damping come from the contact material of (other geometry's material, vertex
+// material). A point with m = 1 over the geometry's own material is left untouched: with d = 0 everywhere the
+// terrain is bit-identical to a plain HeightField.
+//
+// Locked borders (25.1.2.5): setEnableLockedBorders(true) keeps every border vertex (x = 0, x = nx-1, y = 0,
+// y = ny-1) at its height through compression and every other terrain edit.
+//
+// Volume ledger. getVolumeLedger() accounts for all soil, m^3: heightField = sum of height x vertex area over the
+// grid (trapezoid weights: dx dy inside, dx dy / 2 on edges, dx dy / 4 at corners), kept incrementally: a
+// vertex lowered by dz moves area * dz from heightField to compressed (soil made denser, not removed). The other
+// accounts (particles, pending, lostAtBorder, removed) are filled by digging and avalanches; total() is
+// constant through every terrain operation. Heights edited directly on the HeightField (not through the
+// terrain) are not soil the terrain moved: the heightField account follows them at the next step or read
+// (recomputed over the grid once, from the field's dirty rectangle) and the total changes by their volume.
+//
+// Cost. Per step the terrain reads the simulation's contact list; with nothing touching it that is all (no pass
+// over the grid). Loaded vertices are gathered in a sparse list, load averages live on a sparse active list
+// (a vertex leaves it about 1 s after its last contact), and height edits go through batched local HeightField edits
+// (begin/endHeightEdit, one batch per cluster of nearby vertices), so only the touched tiles' bounds are updated.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "scree/collide/geometry.h"
+#include "scree/collide/shapes.h"
+#include "scree/core/listeners.h"
+#include "scree/model/terrain_data_interface.h"
+#include "scree/solver/model.h"
+
+namespace scree {
+
+/// Where the terrain's soil is, m^3 (see terrain.h). total() is conserved by every terrain operation.
+struct TerrainVolumeLedger {
+  Real heightField = 0;   ///< sum of height x vertex area (trapezoid weights)
+  Real compressed = 0;    ///< pressed out of the height by compression (denser soil, not removed)
+  Real particles = 0;     ///< carried by live terrain particles (digging)
+  Real pending = 0;       ///< removed by a shovel, not yet a whole particle (digging)
+  Real lostAtBorder = 0;  ///< avalanched over a locked border with mass loss on
+  Real removed = 0;       ///< particles destroyed by the user or that left the simulation
+  Real total() const { return heightField + compressed + particles + pending + lostAtBorder + removed; }
+};
+
+class Terrain : public Model {
+ public:
+  /// Makes a static geometry (material: none, i.e. the simulation's default until setMaterial) for the field.
+  explicit Terrain(HeightFieldRef heightField);
+  /// A geometry holding a HeightField; on a body it must have an identity local transform.
+  explicit Terrain(GeometryRef terrainGeometry);
+  ~Terrain() override;
+
+  const GeometryRef& getGeometry() const { return geometry_; }
+  const HeightFieldRef& getHeightField() const { return heightField_; }
+
+  TerrainDataInterface& getDataInterface() { return *data_; }
+  const TerrainDataInterface& getDataInterface() const { return *data_; }
+  /// Replaces the data interface with a subclass built for this terrain (TerrainDataInterface(*this)); its
+  /// state starts fresh. Null or one built for another terrain throws std::invalid_argument.
+  void setDataInterface(std::unique_ptr<TerrainDataInterface> dataInterface);
+
+  /// Border vertices keep their height (manual 25.1.2.5). avalancheMassLoss: soil avalanching over a locked
+  /// border is lost (booked as lostAtBorder) instead of held back (used by avalanches).
+  void setEnableLockedBorders(bool enable, bool avalancheMassLoss = true);
+  bool getEnableLockedBorders() const { return lockedBorders_; }
+  bool getAvalancheMassLoss() const { return avalancheMassLoss_; }
+  bool isBorderVertex(size_t x, size_t y) const;
+
+  /// The soil accounts; valid between steps and inside listeners, every step.
+  const TerrainVolumeLedger& getVolumeLedger() const;
+  /// Full-grid trapezoid sum of the heights (the debug check of the ledger's incremental heightField account).
+  Real computeHeightFieldVolume() const;
+  /// Trapezoid weight of vertex (x, y), m^2.
+  Real getVertexArea(size_t x, size_t y) const;
+
+  /// Presses vertex (x, y) down by depth (m, finite, >= 0) as compression does: the height drops, c grows by
+  /// depth log2(M) / D (capped at c_max), the multiplier follows, and the volume moves from heightField to
+  /// compressed. No per-step bound applies (this is not a step). Does nothing and returns false on a
+  /// non-deformable vertex (d = 0 or M = 1) and on a locked border vertex. Use it to pre-compact ground (a
+  /// road, last run's ruts) or to test the law.
+  bool pressVertex(size_t x, size_t y, Real depth);
+
+  /// Closed-form settled plastic sinkage (m) of loose level soil of deformability d under a uniform pressure
+  /// (Pa) with this terrain's p0, M and D: 0 up to p0, +infinity above p0 M (bearing failure). See the file
+  /// comment.
+  Real computeSettledSinkage(Real pressure, Real deformability) const;
+
+  /// The yield reads each vertex's load averaged over this time (s, >= 0; an exponential moving average; at most
+  /// one step: no averaging). Why: a body that follows yielding ground lands on it with impulses ~ m v / h, one
+  /// step long, which a yield law reading single-step forces takes for load and answers by yielding more - at
+  /// small time steps a runaway. The time average of a contact force is the load it carries (momentum
+  /// balance), so averaging over a few damping times removes the impulses and keeps the settled state. Cost: a
+  /// load shorter than this time counts partly (a fast wheel compresses less; docs/terrain.md).
+  static constexpr Real defaultLoadAveragingTime = 0.1;
+  void setLoadAveragingTime(Real seconds);
+  Real getLoadAveragingTime() const { return loadAveragingTime_; }
+
+  /// Vertices loaded by contacts in the last step, and how many of them yielded.
+  size_t getNumLoadedVertices() const { return numLoaded_; }
+  size_t getNumYieldedVertices() const { return numYielded_; }
+  /// Wall-clock time of the terrain's own work in the last step (its contact and post-step listeners), s.
+  double getLastStepTime() const { return lastContactTime_ + lastPostTime_; }
+
+ protected:
+  void onAdd(Simulation& sim) override;
+  void onRemove(Simulation& sim) override;
+
+ private:
+  class ContactListener;
+  class StepListener;
+  friend class TerrainDataInterface;
+
+  void init();
+  /// Triangle under a height-field-frame point: the three vertex indices and barycentric weights. False outside.
+  bool locate(const Vec3& pLocal, size_t (&v)[3], Real (&w)[3]) const;
+  void modifyContact(GeometryContact& contact);
+  void postStep();
+  /// Lowers vertex v by dz > 0 as compression: height, c (and m), and the ledger's heightField -> compressed.
+  void compressVertex(size_t v, Real dz, Real newMultiplier, Real dc);
+  /// Books direct HeightField edits (dirty rectangle) into the heightField account.
+  void reconcileExternalEdits() const;
+  MaterialRef defaultMaterial() const;
+
+  GeometryRef geometry_;
+  HeightFieldRef heightField_;
+  std::unique_ptr<TerrainDataInterface> data_;
+  std::shared_ptr<ContactListener> contactListener_;
+  std::shared_ptr<StepListener> stepListener_;
+  bool lockedBorders_ = false;
+  bool avalancheMassLoss_ = true;
+  size_t nx_ = 0, ny_ = 0;
+  Real dx_ = 0, dy_ = 0;
+  mutable TerrainVolumeLedger ledger_;
+  // Sparse per-step load gathering: load_ is dense (zero between steps), loaded_ lists the vertices written.
+  std::vector<Real> load_;
+  std::vector<Real> avgLoad_, avgStiff_;  ///< load averaged over loadAveragingTime_ (N, N/m)
+  std::vector<size_t> active_;           ///< vertices with a non-zero average
+  Real loadAveragingTime_ = defaultLoadAveragingTime;
+  std::vector<Real> stiffness_;  ///< N/m: barycentric share of the contact points' Young's moduli
+  std::vector<size_t> loaded_;
+  size_t numLoaded_ = 0, numYielded_ = 0;
+  double lastContactTime_ = 0, lastPostTime_ = 0;
+  double contactTimeAccum_ = 0;
+};
+using TerrainRef = std::shared_ptr<Terrain>;
+
+}  // namespace scree

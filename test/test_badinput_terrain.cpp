@@ -1,0 +1,157 @@
+// Terrain bad input: every rejected call throws std::invalid_argument with a message naming the problem, and
+// leaves the terrain unchanged (material map, compression, multipliers, parameters, heights and the ledger).
+#include <doctest/doctest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <vector>
+
+#include "png_test_files.h"
+#include "terrain_world.h"
+
+using namespace scree;
+using namespace scree::test;
+
+namespace {
+
+constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
+
+/// Everything a rejected call must leave alone.
+struct Snapshot {
+  std::vector<size_t> index;
+  std::vector<Real> compression, multiplier, heights;
+  Real M, D, maxChange, p0, ledgerTotal, ledgerHeightField;
+  std::vector<MaterialRef> materials;
+  explicit Snapshot(const Terrain& t) {
+    const TerrainDataInterface& di = t.getDataInterface();
+    for (size_t y = 0; y < di.getResolutionY(); ++y)
+      for (size_t x = 0; x < di.getResolutionX(); ++x) {
+        index.push_back(di.getMaterialIndex(x, y));
+        compression.push_back(di.getCompression(x, y));
+        multiplier.push_back(di.getYoungsModulusMultiplier(x, y));
+        materials.push_back(di.getMaterial(x, y));
+      }
+    heights = t.getHeightField()->getHeights();
+    M = di.getMaxCompressionMultiplier();
+    D = di.getDepthForMaxCompression();
+    maxChange = di.getMaxYoungsChangePerTimestep();
+    p0 = di.getYieldPressure();
+    ledgerTotal = t.getVolumeLedger().total();
+    ledgerHeightField = t.getVolumeLedger().heightField;
+  }
+  bool operator==(const Snapshot& o) const {
+    return index == o.index && compression == o.compression && multiplier == o.multiplier && heights == o.heights &&
+           M == o.M && D == o.D && maxChange == o.maxChange && p0 == o.p0 && ledgerTotal == o.ledgerTotal &&
+           ledgerHeightField == o.ledgerHeightField && materials == o.materials;
+  }
+};
+
+std::string tempPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("scree_terrain_bad_" + name)).string();
+}
+
+#define CHECK_REJECTED(call, text)                                                   \
+  do {                                                                               \
+    const Snapshot before(*t);                                                       \
+    CHECK_THROWS_WITH_AS(call, doctest::Contains(text), std::invalid_argument);     \
+    CHECK(Snapshot(*t) == before);                                                   \
+  } while (0)
+
+}  // namespace
+
+TEST_SUITE("terrain bad input") {
+  TEST_CASE("material map files: missing, not a PNG, truncated, wrong size, unsupported format") {
+    TestWorld w;
+    TerrainRef t = addFlatTerrain(w, 6, 5.0);  // 6 x 6 vertices
+    TerrainDataInterface& di = t->getDataInterface();
+    auto sand = std::make_shared<Material>("sand");
+    di.add(sand, 1, 0.0, 1.0);
+    di.setMaterialMapping(2, 3, 1);
+    di.setCompression(2, 3, 0.5);
+    // A good map for reference: it loads.
+    std::vector<std::vector<uint8_t>> good(6, std::vector<uint8_t>(6, 1));
+    const std::string okPath = tempPath("ok.png");
+    writeBytes(okPath, makeIndexPng(good));
+
+    CHECK_REJECTED(di.setMaterialMapping(tempPath("does_not_exist.png")), "no such file");
+    const std::string text = tempPath("text.png");
+    writeBytes(text, std::vector<uint8_t>{'h', 'e', 'l', 'l', 'o', ' ', 'p', 'n', 'g', '\n'});
+    CHECK_REJECTED(di.setMaterialMapping(text), "not a PNG");
+    const std::vector<uint8_t> bytes = makeIndexPng(good);
+    const std::string truncated = tempPath("truncated.png");
+    writeBytes(truncated, std::vector<uint8_t>(bytes.begin(), bytes.begin() + std::ptrdiff_t(bytes.size() / 2)));
+    CHECK_REJECTED(di.setMaterialMapping(truncated), "truncated");
+    const std::string small = tempPath("small.png");
+    writeBytes(small, makeIndexPng(std::vector<std::vector<uint8_t>>(5, std::vector<uint8_t>(6, 1))));
+    CHECK_REJECTED(di.setMaterialMapping(small), "must match the height-field resolution 6 x 6");
+    const std::string transposed = tempPath("transposed.png");
+    writeBytes(transposed, makeIndexPng(std::vector<std::vector<uint8_t>>(6, std::vector<uint8_t>(7, 1))));
+    CHECK_REJECTED(di.setMaterialMapping(transposed), "7 x 6 pixels");
+    // 16-bit grey: samples are not indices 0..255.
+    const std::string deep = tempPath("gray16.png");
+    writeBytes(deep, makePng(6, 6, 16, 0, std::vector<std::vector<uint8_t>>(6, std::vector<uint8_t>(12, 0))));
+    CHECK_REJECTED(di.setMaterialMapping(deep), "unsupported");
+    // RGB with coloured pixels: not an index map.
+    std::vector<std::vector<uint8_t>> rgb(6, std::vector<uint8_t>(18, 0));
+    rgb[0][0] = 255;
+    const std::string colour = tempPath("rgb.png");
+    writeBytes(colour, makePng(6, 6, 8, 2, rgb));
+    CHECK_THROWS_AS(di.setMaterialMapping(colour), std::invalid_argument);
+    CHECK_NOTHROW(di.setMaterialMapping(okPath));
+    CHECK(di.getMaterial(0, 0) == sand);
+    for (const auto& p : {okPath, text, truncated, small, transposed, deep, colour}) std::remove(p.c_str());
+  }
+
+  TEST_CASE("data interface setters reject bad values and leave the terrain unchanged") {
+    TestWorld w;
+    TerrainRef t = addFlatTerrain(w, 6, 5.0);
+    TerrainDataInterface& di = t->getDataInterface();
+    auto sand = std::make_shared<Material>("sand");
+    di.add(sand, 1, 0.0, 1.0);
+    di.setMaterialMapping(1, 1, 1);
+    t->pressVertex(1, 1, 0.05);
+    CHECK(t->getVolumeLedger().compressed > 0);
+
+    CHECK_REJECTED(di.setMaterialMapping(1, 1, 256), "materialIndex = 256");
+    CHECK_REJECTED(di.setMaterialMapping(6, 1, 1), "x = 6");
+    CHECK_REJECTED(di.setMaterialMapping(1, 6, 1), "y = 6");
+    CHECK_REJECTED(di.add(sand, 256), "materialIndex = 256");
+    CHECK_REJECTED(di.add(nullptr, 2), "material = null");
+    CHECK_REJECTED(di.add(sand, 2, -1.0), "particleAdhesion = -1");
+    CHECK_REJECTED(di.add(sand, 2, 0.0, -0.5), "deformability = -0.5");
+    CHECK_REJECTED(di.add(sand, 2, kNaN), "particleAdhesion = nan");
+    CHECK_REJECTED(di.add(sand, 2, 0.0, kNaN), "deformability = nan");
+    CHECK_REJECTED(di.add(sand, 2, 0.0, 1.0, kNaN), "angleOfRepose = nan");
+    CHECK_REJECTED(di.add(sand, 2, 0.0, 1.0, 2.0), "angleOfRepose = 2");
+    CHECK_REJECTED(di.setMaxCompressionMultiplier(0.5), "multiplier = 0.5");
+    CHECK_REJECTED(di.setMaxCompressionMultiplier(-4), "must be finite and >= 1");
+    CHECK_REJECTED(di.setMaxCompressionMultiplier(6), "must be a power of two");
+    CHECK_REJECTED(di.setMaxCompressionMultiplier(kNaN), "multiplier = nan");
+    CHECK_REJECTED(di.setMaxCompressionMultiplier(std::numeric_limits<Real>::infinity()), "multiplier = inf");
+    CHECK_REJECTED(di.setDepthForMaxCompression(0), "depth = 0");
+    CHECK_REJECTED(di.setDepthForMaxCompression(-0.1), "depth = -0.1");
+    CHECK_REJECTED(di.setDepthForMaxCompression(kNaN), "depth = nan");
+    CHECK_REJECTED(di.setMaxYoungsChangePerTimestep(-1), "maxMultiplierChange = -1");
+    CHECK_REJECTED(di.setMaxYoungsChangePerTimestep(kNaN), "maxMultiplierChange = nan");
+    CHECK_REJECTED(di.setYieldPressure(0), "pressure = 0");
+    CHECK_REJECTED(di.setYieldPressure(kNaN), "pressure = nan");
+    CHECK_REJECTED(di.setCompression(1, 1, -0.1), "compression = -0.1");
+    CHECK_REJECTED(di.setCompression(1, 1, kNaN), "compression = nan");
+    CHECK_REJECTED(di.setCompression(9, 1, 0.1), "x = 9");
+    CHECK_REJECTED(di.getCompression(1, 9), "y = 9");
+    CHECK_REJECTED(di.getYoungsModulusMultiplier(6, 0), "x = 6");
+    CHECK_REJECTED(di.getMaterial(0, 6), "y = 6");
+    CHECK_REJECTED(t->pressVertex(1, 1, -0.01), "depth = -0.01");
+    CHECK_REJECTED(t->pressVertex(1, 1, kNaN), "depth = nan");
+    CHECK_REJECTED(t->pressVertex(6, 1, 0.01), "x = 6");
+    CHECK_REJECTED(t->setDataInterface(nullptr), "dataInterface = null");
+    // Accepted edge values.
+    CHECK_NOTHROW(di.setMaxCompressionMultiplier(1));
+    CHECK_NOTHROW(di.setMaxCompressionMultiplier(1024));
+    CHECK_NOTHROW(di.setMaxYoungsChangePerTimestep(0));
+    CHECK_NOTHROW(di.setMaxYoungsChangePerTimestep(std::numeric_limits<Real>::infinity()));
+    CHECK(t->getVolumeLedger().total() == doctest::Approx(t->computeHeightFieldVolume() +
+                                                          t->getVolumeLedger().compressed));
+  }
+}
