@@ -25,7 +25,7 @@ inline TerrainRef addFlatTerrain(TestWorld& w, size_t n, Real size, Real thickne
 }
 
 /// Steps n times and checks after every step that the ledger total stays at its value before the first step to
-/// 1e-9 relative (TERRAIN invariant: no terrain operation creates or destroys soil), and at the end that the
+/// 1e-9 relative (the ledger invariant, docs/terrain.md: no terrain operation creates or destroys soil), and at the end that the
 /// incremental heightField account equals the full-grid sum (same bound). Returns the largest relative drift.
 inline Real stepCheckingLedger(TestWorld& w, const Terrain& t, int n) {
   const Real total0 = t.getVolumeLedger().total();

@@ -51,7 +51,7 @@ Real maxDepthBetween(const Simulation& sim, const RigidBody* a, const RigidBody*
 TEST_CASE("chain20 (100:1) hanging at rest: DIRECT joint error is the joint's elastic stretch" *
           test::needsDirectSolver()) {
   // The top joint carries the whole chain: (20 x 1 kg + 100 kg) g = 1177.2 N; with the default compliance
-  // 1e-8 m/N SPOOK settles it at the stretch F eps = 1.1772e-5 m (DESIGN.md §3: lambda/h = -g/eps at rest). The
+  // 1e-8 m/N SPOOK settles it at the stretch F eps = 1.1772e-5 m (docs/design.md §3: lambda/h = -g/eps at rest). The
   // direct solve is exact up to round-off, so the worst error over the 600 steps equals that stretch; 1 %
   // covers the other joints' smaller stretch never exceeding the top one and the transient of the first steps.
   const Real topForce = (20 * 1.0 + 100.0) * kG;

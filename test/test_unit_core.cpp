@@ -100,7 +100,7 @@ TEST_SUITE("core") {
     cm->setFrictionCoefficient(0.1);
     mm.resolve(a.get(), b.get(), p, &fm);
     CHECK(p.getFrictionCoefficient() == doctest::Approx(0.1));
-    // Defaults of DESIGN.md section 3.
+    // Defaults of docs/design.md section 3.
     Material d("d");
     CHECK(d.getDensity() == 1000);
     CHECK(d.getYoungsModulus() == 4e8);

@@ -1,4 +1,4 @@
-// libccd adapter: the only file that includes libccd (DESIGN.md §2, STYLE.md §2).
+// libccd adapter: the only file that includes libccd (docs/design.md §1).
 //
 // Used for the convex pairs without an analytic routine (cylinder-cylinder, cylinder-box, cylinder-capsule,
 // cylinder-convex, sphere-convex, capsule-convex). One point per call: a curved pair gets a new point every step

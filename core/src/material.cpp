@@ -66,7 +66,7 @@ void Material::setDensity(Real rho) {
 
 void ContactMaterial::combine(const Material& a, const Material& b, SurfaceParameters& out) {
   // Springs in series for stiffness; geometric means for friction and restitution; sums for the viscous
-  // compliance and adhesion (DESIGN.md §3). Damping time: the mean, so equal materials keep their value.
+  // compliance and adhesion (docs/design.md §3). Damping time: the mean, so equal materials keep their value.
   struct Access : SurfaceParameters {
     static void set(SurfaceParameters& o, Real E, Real tau, Real mu, Real e, Real af, Real ao, Real sv, Real rr) {
       Access& s = static_cast<Access&>(o);

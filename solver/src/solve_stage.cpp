@@ -1,5 +1,5 @@
 // Solve stage: the velocity solve of this step's rows and particle contact units, by one of four paths
-// chosen from what the step holds (DESIGN.md §2 step 7, §4):
+// chosen from what the step holds (docs/design.md §2 and §4):
 //
 //   path         when                                          what runs
 //   NOTHING      no rows, no particle units                    nothing
@@ -101,7 +101,7 @@ void directSolve(SimulationState& s) {
   }
 }
 
-/// HYBRID (DESIGN.md §4): direct solve of the direct set with the iterative rows' impulses held, then PGS
+/// HYBRID (docs/design.md §4): direct solve of the direct set with the iterative rows' impulses held, then PGS
 /// sweeps over the iterative set with the direct impulses held, numHybridRounds times; SPLIT friction ends
 /// with one more direct solve of the normals. The rigid shock pass visits only couplings whose rows are all
 /// iterative. Then the iterative particle units are swept with the rows' impulses held.

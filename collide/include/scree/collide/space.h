@@ -37,7 +37,7 @@ class Space {
   void setContactMargin(Real m);
   Real getContactMargin() const { return margin_; }
 
-  detail::UniformGrid& getBroadphase() { return grid_; }
+  const detail::UniformGrid& getBroadphase() const { return grid_; }
 
   /// Updates world transforms, computes AABBs grown by each body's motion over `h` (speculative contacts),
   /// runs broad- and narrowphase and replaces the contents of `out` with the touching pairs (its elements and

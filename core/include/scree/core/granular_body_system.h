@@ -1,6 +1,6 @@
 // GranularBodySystem (AGX: agx::GranularBodySystem): the particle container.
 //
-// Storage is structure-of-arrays (STYLE.md §3): one contiguous array per attribute, indexed by a dense index
+// Storage is structure-of-arrays: one contiguous array per attribute, indexed by a dense index
 // 0 .. size()-1. No per-particle objects. The arrays, their shapes and units:
 //   positions()        [size()] Vec3, m, world frame (particle centre)
 //   velocities()       [size()] Vec3, m/s

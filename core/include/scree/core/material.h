@@ -1,7 +1,7 @@
 // Materials, contact materials and friction models (AGX: agx::Material, agx::ContactMaterial,
 // agx::MaterialManager, agx::FrictionModel).
 //
-// Defaults (DESIGN.md §3, what AGX users expect), each defined once below in `MaterialDefaults`:
+// Defaults (docs/design.md §3, what AGX users expect), each defined once below in `MaterialDefaults`:
 //   density 1000 kg/m^3; Young's modulus 4e8 Pa, used as the contact's normal spring constant per contact
 //   point (N/m; see solver/spook.h for the mapping to SPOOK compliance); restitution 0.5; contact damping
 //   time 0.075 s; friction coefficient 0.41667; surface viscosity (friction-row compliance) 5e-9 m/(N s);

@@ -12,7 +12,7 @@
 // Nothing else is constrained: the rim (and the tire with it) spins freely about the axle; drive it with a
 // Hinge motor between chassis and rim. Tire and rim do not collide with each other (Constraint default).
 //
-// SPOOK mapping (spook.h, DESIGN.md §3): a stiffness K and damping coefficient D (the manual's units) become
+// SPOOK mapping (spook.h, docs/design.md §3): a stiffness K and damping coefficient D (the manual's units) become
 // compliance 1/K and damping time D/K per row, i.e. a spring K in parallel with a damper D. Defaults are the
 // ones AGX ships: RADIAL 3.5e5 N/m with 7e3 N s/m; LATERAL 3e5 N/m, BENDING and TORSIONAL 3e5 N m/rad, each
 // with damping 5e3.

@@ -1,4 +1,4 @@
-// DIRECT solver on SuiteSparse CHOLMOD (DESIGN.md §4). Reads only core types and rows, like PGS, so tests can
+// DIRECT solver on SuiteSparse CHOLMOD (docs/design.md §4). Reads only core types and rows, like PGS, so tests can
 // feed hand-built systems.
 //
 // The rows of the direct set D are solved together with every other row's impulse held fixed (their effect is

@@ -1,4 +1,4 @@
-// Projected Gauss-Seidel on the Schur form (DESIGN.md §4). Reads only core types and rows, so tests can feed
+// Projected Gauss-Seidel on the Schur form (docs/design.md §4). Reads only core types and rows, so tests can feed
 // hand-built systems.
 //
 // Per row i: delta = (rhs_i - J_i v - e_i lambda_i) / (J_i M^-1 J_i^T + e_i), lambda_i <- clamp(lambda_i + delta),

@@ -1,5 +1,5 @@
 // Simulation (AGX: agxSDK::Simulation): owns the bodies, geometries, constraints and listeners, and runs
-// the step. stepForward() is a fixed pipeline of named stages (DESIGN.md §2), each timed in StepStats:
+// the step. stepForward() is a fixed pipeline of named stages (docs/design.md §2), each timed in StepStats:
 //   PRE_COLLIDE listeners; collision (geometries synced with the space, Space broadphase + narrowphase,
 //   particle collision, contact materials resolved); contact listeners; PRE_STEP listeners; forces (free
 //   velocities); rows (contacts, constraints, particles); solve (PGS, DIRECT or hybrid, particle sweeps);

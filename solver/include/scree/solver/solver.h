@@ -39,7 +39,7 @@ struct SolverStats {
 
 class Solver {
  public:
-  /// Matrix form of the DIRECT solve (DESIGN.md §4). SCHUR: A = G M^-1 G^T + E, CHOLMOD LL^T. KKT: the
+  /// Matrix form of the DIRECT solve (docs/design.md §4). SCHUR: A = G M^-1 G^T + E, CHOLMOD LL^T. KKT: the
   /// quasi-definite [M -G^T; -G -E], CHOLMOD LDL^T without pivoting. AUTO: KKT when the Schur matrix would have
   /// more nonzeros than DirectSolver::kktRatio (1) times the KKT matrix (bodies carrying many rows), else SCHUR (see
   /// docs/speed-accuracy.md for the measurements behind it).
