@@ -133,6 +133,8 @@ void Terrain::findShovels(std::vector<Shovel>& out) {
       }
       return;
     }
+    // The pose this step will collide at (the simulation syncs geometries after the pre-collide listeners).
+    gr->updateTransform();
     Shovel s;
     s.geometry = &g;
     const Transform& G = g.getTransform();
@@ -325,6 +327,15 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
               const Vec3 p(x0 + u, y0 + w, (Real(kz) + b[2]) * a);
               const Real above = (p - planePoint).dot(s.upL);
               if (!(above >= r) || !(p.z() >= h + r)) continue;
+              // Clear of the ground around it: r above the highest corner of the cell holding the site (a site
+              // in a cut column next to uncut ground would otherwise start inside the slope and fall through).
+              {
+                const size_t ci = std::min(size_t(std::max<Real>(0, u / dx_)), nx_ - 2);
+                const size_t cj = std::min(size_t(std::max<Real>(0, w / dy_)), ny_ - 2);
+                const Real top = std::max(std::max(heightField_->getHeight(ci, cj), heightField_->getHeight(ci + 1, cj)),
+                                          std::max(heightField_->getHeight(ci, cj + 1), heightField_->getHeight(ci + 1, cj + 1)));
+                if (!(p.z() >= top + r)) continue;
+              }
               const Vec3 pw = T.apply(p);
               if (!(pw.x() >= s.box.lo.x() && pw.x() <= s.box.hi.x() && pw.y() >= s.box.lo.y() &&
                     pw.y() <= s.box.hi.y()))
