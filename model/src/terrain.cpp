@@ -47,7 +47,8 @@ class Terrain::ContactListener : public ContactEventListener {
 
 class Terrain::StepListener : public StepEventListener {
  public:
-  explicit StepListener(Terrain* t) : StepEventListener(POST_STEP), t_(t) {}
+  explicit StepListener(Terrain* t) : StepEventListener(PRE_COLLIDE | POST_STEP), t_(t) {}
+  void preCollide(const TimeStamp&) override { t_->preCollide(); }
   void post(const TimeStamp&) override { t_->postStep(); }
 
  private:
@@ -90,6 +91,7 @@ void Terrain::init() {
   stiffness_.assign(nx_ * ny_, 0.0);
   avgLoad_.assign(nx_ * ny_, 0.0);
   avgStiff_.assign(nx_ * ny_, 0.0);
+  pending_.assign(nx_ * ny_, 0.0);
   loaded_.reserve(64);
   ledger_.heightField = computeHeightFieldVolume();
   heightField_->clearDirtyRectangle();

@@ -93,8 +93,9 @@ class TerrainDataInterface {
   /// The registered material of the vertex, or the terrain's default material for an unmapped vertex (may be
   /// null only when the terrain geometry has no material and the terrain is not in a simulation).
   virtual MaterialRef getMaterial(size_t x, size_t y) const;
-  /// Material of particles made from this vertex. Until digging derives particle materials (particle adhesion,
-  /// particle Young's multiplier) this is getMaterial(x, y).
+  /// The material particles made from this vertex take their surface parameters from: getMaterial(x, y). Digging
+  /// makes each particle a derived material (density for mass = bulk density x carried volume, the particle
+  /// adhesion between particles; terrain.h).
   virtual MaterialRef getParticleMaterial(size_t x, size_t y) const;
   /// Terrain properties of the vertex's material (0 for an unmapped vertex).
   virtual Real getDeformability(size_t x, size_t y) const;

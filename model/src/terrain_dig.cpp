@@ -1,0 +1,438 @@
+// Terrain digging: shovel discovery and validation, the cut, particle creation on the FCC lattice and merging
+// back (the rules are in terrain.h's file comment; the volume moves through the ledger, never created or lost).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <unordered_map>
+
+#include "scree/core/errors.h"
+#include "scree/core/logger.h"
+#include "scree/model/terrain.h"
+#include "scree/solver/simulation.h"
+
+namespace scree {
+
+namespace {
+constexpr Real kSqrt2 = 1.41421356237309504880;
+constexpr Real kPi = 3.14159265358979323846;
+/// |cos(up, forward)| above this is "not orthogonal".
+constexpr Real kOrthogonalityTolerance = 1e-6;
+/// N: the adhesive force of particle contacts when the material's particle adhesion is 0 (see particleMaterial).
+constexpr Real kNoAdhesion = 1e-9;
+}  // namespace
+
+// ---- particle attributes ------------------------------------------------------------------------------------
+void TerrainParticleAttributes::setParticleRadius(Real radius) {
+  constexpr const char* where = "TerrainParticleAttributes::setParticleRadius";
+  const Real maxR = terrain_.getMaximumParticleRadius();
+  if (!(std::isfinite(radius) && radius > 0 && radius <= maxR))
+    detail::throwInvalid(where, "radius", radius,
+                         "must be finite, > 0 and <= Terrain::getMaximumParticleRadius() = " +
+                             detail::formatValue(maxR));
+  radius_ = radius;
+}
+
+Real TerrainParticleAttributes::getParticleRadius() const {
+  if (radius_ > 0) return radius_;
+  return terrain_.getMaximumParticleRadius() / (2 * (3 * kSqrt2 - 2));
+}
+
+// ---- settings and read-outs -----------------------------------------------------------------------------------
+std::string Terrain::checkShovelVectors(const Vec3& up, const Vec3& forward) {
+  if (!up.allFinite()) return "ShovelUpProperty " + detail::formatValue(up) + " is not finite";
+  if (!forward.allFinite()) return "ShovelForwardProperty " + detail::formatValue(forward) + " is not finite";
+  if (!(up.norm() > 0)) return "ShovelUpProperty is the zero vector";
+  if (!(forward.norm() > 0)) return "ShovelForwardProperty is the zero vector";
+  const Real c = up.dot(forward) / (up.norm() * forward.norm());
+  if (!(std::abs(c) <= kOrthogonalityTolerance))
+    return "ShovelUpProperty " + detail::formatValue(up) + " and ShovelForwardProperty " +
+           detail::formatValue(forward) + " are not orthogonal (cosine " + detail::formatValue(c) + ", tolerance 1e-6)";
+  return {};
+}
+
+namespace {
+/// "" when g is a valid shovel; "-" when it has neither property (not meant as a shovel); else the problem.
+std::string shovelProblem(const Geometry& g) {
+  const PropertyContainer& pc = g.getPropertyContainer();
+  const bool hasUp = pc.hasProperty(Terrain::ShovelUpProperty);
+  const bool hasFwd = pc.hasProperty(Terrain::ShovelForwardProperty);
+  if (!hasUp && !hasFwd) return "-";
+  if (!hasUp) return "ShovelUpProperty is missing";
+  if (!hasFwd) return "ShovelForwardProperty is missing";
+  if (!pc.hasPropertyVec3(Terrain::ShovelUpProperty)) return "ShovelUpProperty is not a Vec3";
+  if (!pc.hasPropertyVec3(Terrain::ShovelForwardProperty)) return "ShovelForwardProperty is not a Vec3";
+  return Terrain::checkShovelVectors(pc.getPropertyVec3(Terrain::ShovelUpProperty),
+                                     pc.getPropertyVec3(Terrain::ShovelForwardProperty));
+}
+}  // namespace
+
+bool Terrain::isGeometryShovel(const Geometry& g) const { return shovelProblem(g).empty(); }
+
+void Terrain::setShovelMinimumDigAngleToHorizontalPlane(Real angle) {
+  if (!(angle >= 0 && angle <= kPi / 2))
+    detail::throwInvalid("Terrain::setShovelMinimumDigAngleToHorizontalPlane", "angle", angle,
+                         "must be in [0, pi/2]");
+  minDigAngle_ = angle;
+}
+
+void Terrain::setMergeVelocity(Real v) {
+  if (!(std::isfinite(v) && v >= 0))
+    detail::throwInvalid("Terrain::setMergeVelocity", "velocity", v, "must be finite and >= 0");
+  mergeVelocity_ = v;
+}
+
+Real Terrain::getParticleLatticeDistance() const {
+  return particleAttributes_.getParticleRadius() * (3 - kSqrt2);
+}
+
+Real Terrain::getParticleVolume() const {
+  const Real a = kSqrt2 * getParticleLatticeDistance();
+  return a * a * a / 4;
+}
+
+std::vector<size_t> Terrain::getParticleIds() const {
+  std::vector<size_t> ids;
+  ids.reserve(particles_.size());
+  for (const auto& p : particles_) ids.push_back(p.first);
+  return ids;
+}
+
+Real Terrain::getParticleCarriedVolume(size_t id) const {
+  for (const auto& p : particles_)
+    if (p.first == id) return p.second;
+  return 0;
+}
+
+// ---- the step ---------------------------------------------------------------------------------------------------
+struct Terrain::Shovel {
+  const Geometry* geometry = nullptr;
+  Vec3 upL, tipL;        ///< unit up and the tip, in the height field's frame
+  Real thickness = 0;    ///< |up|
+  Aabb box;              ///< world bounding box
+  Aabb zone;             ///< non-merge zone: box grown by one particle diameter
+  Real boxLowL = 0;      ///< lowest z of the box in the field's frame
+  Real loX = 0, hiX = 0, loY = 0, hiY = 0;  ///< footprint in the field's frame
+  const RigidBody* body = nullptr;
+};
+
+void Terrain::findShovels(std::vector<Shovel>& out) {
+  Simulation& sim = *getSimulation();
+  const Transform& T = geometry_->getTransform();
+  const Real r = particleAttributes_.getParticleRadius();
+  auto consider = [&](const GeometryRef& gr) {
+    const Geometry& g = *gr;
+    if (&g == geometry_.get()) return;
+    const std::string problem = shovelProblem(g);
+    if (problem == "-") return;
+    if (!problem.empty()) {
+      if (std::find(reportedBadShovels_.begin(), reportedBadShovels_.end(), &g) == reportedBadShovels_.end()) {
+        reportedBadShovels_.push_back(&g);
+        Logger::error("Terrain \"" + getModelName() + "\": geometry \"" + g.getName() +
+                      "\" is not a shovel: " + problem);
+      }
+      return;
+    }
+    // The pose this step will collide at (the simulation syncs geometries after the pre-collide listeners).
+    gr->updateTransform();
+    Shovel s;
+    s.geometry = &g;
+    const Transform& G = g.getTransform();
+    const PropertyContainer& pc = g.getPropertyContainer();
+    const Vec3 up = G.rotate(pc.getPropertyVec3(ShovelUpProperty));
+    const Vec3 fwd = G.rotate(pc.getPropertyVec3(ShovelForwardProperty));
+    s.thickness = up.norm();
+    s.upL = T.rotateInverse(up / s.thickness);
+    s.tipL = T.applyInverse(G.p + fwd);
+    s.box = g.getBoundingBox();
+    s.zone = s.box;
+    s.zone.lo -= Vec3::Constant(2 * r);
+    s.zone.hi += Vec3::Constant(2 * r);
+    s.loX = s.loY = s.boxLowL = std::numeric_limits<Real>::infinity();
+    s.hiX = s.hiY = -std::numeric_limits<Real>::infinity();
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 c((k & 1) ? s.box.hi.x() : s.box.lo.x(), (k & 2) ? s.box.hi.y() : s.box.lo.y(),
+                   (k & 4) ? s.box.hi.z() : s.box.lo.z());
+      const Vec3 l = T.applyInverse(c);
+      s.loX = std::min(s.loX, l.x()), s.hiX = std::max(s.hiX, l.x());
+      s.loY = std::min(s.loY, l.y()), s.hiY = std::max(s.hiY, l.y());
+      s.boxLowL = std::min(s.boxLowL, l.z());
+    }
+    s.body = g.getRigidBody();
+    out.push_back(s);
+  };
+  for (const RigidBodyRef& b : sim.getRigidBodies())
+    for (const GeometryRef& g : b->getGeometries()) consider(g);
+  for (const GeometryRef& g : sim.getStaticGeometries()) consider(g);
+}
+
+void Terrain::preCollide() {
+  digStats_ = TerrainDigStats{};
+  Simulation* sim = getSimulation();
+  if (!sim) return;
+  reconcileExternalEdits();
+  geometry_->updateTransform();
+  std::vector<Shovel> shovels;
+  findShovels(shovels);
+  heightField_->beginHeightEdit();
+  mergeParticles(shovels);
+  for (const Shovel& s : shovels) cut(s);
+  heightField_->endHeightEdit();
+  heightField_->clearDirtyRectangle();
+}
+
+void Terrain::cut(const Shovel& s) {
+  // Not upside down, and up at least the minimum dig angle above the horizontal plane (terrain.h).
+  if (!(s.upL.z() > 0) || std::asin(std::min<Real>(1, s.upL.z())) < minDigAngle_) return;
+  const Real x0 = -0.5 * heightField_->getSizeX(), y0 = -0.5 * heightField_->getSizeY();
+  const auto clampIndex = [](Real u, size_t n) -> long long {
+    return std::clamp<long long>((long long)std::floor(u), -1, (long long)n);
+  };
+  const long long i0 = std::max<long long>(0, clampIndex((s.loX - x0) / dx_, nx_) + 1);
+  const long long i1 = std::min<long long>((long long)nx_ - 1, clampIndex((s.hiX - x0) / dx_, nx_));
+  const long long j0 = std::max<long long>(0, clampIndex((s.loY - y0) / dy_, ny_) + 1);
+  const long long j1 = std::min<long long>((long long)ny_ - 1, clampIndex((s.hiY - y0) / dy_, ny_));
+  if (i0 > i1 || j0 > j1) return;
+  TerrainDataInterface& di = *data_;
+  const Real M = di.maxMultiplier_, D = di.depthForMax_;
+  const Vec3& n = s.upL;
+  for (long long j = j0; j <= j1; ++j)
+    for (long long i = i0; i <= i1; ++i) {
+      if (lockedBorders_ && isBorderVertex(size_t(i), size_t(j))) continue;
+      const Real x = x0 + Real(i) * dx_, y = y0 + Real(j) * dy_;
+      const Real zPlane = s.tipL.z() - (n.x() * (x - s.tipL.x()) + n.y() * (y - s.tipL.y())) / n.z();
+      const Real floor = std::max(zPlane, s.boxLowL);
+      const Real h = heightField_->getHeight(size_t(i), size_t(j));
+      if (!(h > floor)) continue;
+      const Real dz = h - floor;
+      const size_t v = size_t(j) * nx_ + size_t(i);
+      heightField_->setHeight(size_t(i), size_t(j), floor);
+      const Real vol = getVertexArea(size_t(i), size_t(j)) * dz;
+      ledger_.heightField -= vol;
+      ledger_.pending += vol;
+      pending_[v] += vol;
+      digStats_.volumeDug += vol;
+      // Dug deeper: harder ground (the compression rule, capped at c_max), deformable vertices only.
+      const Real d = di.deformabilityOf(v);
+      if (d > 0 && M > 1) {
+        const Real cMax = std::log2(M) / (d + 1);
+        di.compression_[v] = std::min(di.compression_[v] + dz * std::log2(M) / D, std::max(di.compression_[v], cMax));
+        di.multiplier_[v] = TerrainDataInterface::multiplier(di.compression_[v], d, M);
+      }
+    }
+  createParticles(s, size_t(i0), size_t(i1), size_t(j0), size_t(j1));
+}
+
+MaterialRef Terrain::particleMaterial(size_t v) {
+  const TerrainDataInterface& di = *data_;
+  MaterialRef src = di.entries_[di.index_[v]].material;
+  if (!src) src = defaultMaterial();
+  const Real adhesion = di.entries_[di.index_[v]].particleAdhesion;
+  const Real r = particleAttributes_.getParticleRadius();
+  const Real density = src->getDensity();
+  for (ParticleMaterialCache& c : particleMaterials_)
+    if (c.source == src.get() && c.radius == r && c.adhesion == adhesion && c.density == density) return c.material;
+  // A new material (its own id) with the vertex material's surface parameters and no adhesion of its own; mass
+  // = bulk density x carried volume: the sphere of radius r gets density rho V / (4/3 pi r^3).
+  auto m = std::make_shared<Material>(src->getName() + " (terrain particles)");
+  static_cast<SurfaceParameters&>(*m) = static_cast<const SurfaceParameters&>(*src);
+  m->setAdhesion(0, 0);
+  m->setDensity(density * getParticleVolume() / (4.0 / 3.0 * kPi * r * r * r));
+  // Particle-particle contacts: the vertex material's parameters, resting at the lattice's overlap r(sqrt2 - 1)
+  // with the particle adhesion. The contact law applies a rest overlap only to adhesive contacts, so adhesion 0
+  // becomes a negligible kNoAdhesion: lattice neighbours rest where they are made instead of flying apart.
+  auto cm = std::make_shared<ContactMaterial>(m, m);
+  static_cast<SurfaceParameters&>(*cm) = static_cast<const SurfaceParameters&>(*src);
+  cm->setAdhesion(std::max(adhesion, kNoAdhesion), r * (kSqrt2 - 1));
+  getSimulation()->getMaterialManager().add(cm);
+  particleMaterials_.push_back({src.get(), r, adhesion, density, m});
+  return m;
+}
+
+namespace {
+struct CellKey {
+  long long x, y, z;
+  bool operator==(const CellKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+struct CellHash {
+  size_t operator()(const CellKey& k) const {
+    return size_t(k.x * 73856093LL) ^ size_t(k.y * 19349663LL) ^ size_t(k.z * 83492791LL);
+  }
+};
+}  // namespace
+
+void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, size_t j1) {
+  const Real V = getParticleVolume();
+  bool any = false;
+  for (size_t j = j0; j <= j1 && !any; ++j)
+    for (size_t i = i0; i <= i1; ++i)
+      if (pending_[j * nx_ + i] >= V) {
+        any = true;
+        break;
+      }
+  if (!any) return;
+  GranularBodySystem& gbs = getSimulation()->getGranularBodySystem();
+  gbs.addCustomBufferReal(ParticleVolumeBuffer);
+  const Transform& T = geometry_->getTransform();
+  const Real r = particleAttributes_.getParticleRadius();
+  const Real d = getParticleLatticeDistance(), a = kSqrt2 * d;
+  const Real x0 = -0.5 * heightField_->getSizeX(), y0 = -0.5 * heightField_->getSizeY();
+  // Terrain particles near the footprint, hashed by lattice cube (d < a: neighbours are in the 27 cubes).
+  std::unordered_map<CellKey, std::vector<Vec3>, CellHash> grid;
+  auto keyOf = [&](const Vec3& p) {
+    return CellKey{(long long)std::floor(p.x() / a), (long long)std::floor(p.y() / a), (long long)std::floor(p.z() / a)};
+  };
+  for (const auto& [id, vol] : particles_)
+    if (gbs.isValid(id)) {
+      const Vec3 p = T.applyInverse(gbs.getPosition(id));
+      grid[keyOf(p)].push_back(p);
+    }
+  auto free = [&](const Vec3& p) {
+    const CellKey k = keyOf(p);
+    for (long long dz = -1; dz <= 1; ++dz)
+      for (long long dy = -1; dy <= 1; ++dy)
+        for (long long dx = -1; dx <= 1; ++dx) {
+          auto it = grid.find(CellKey{k.x + dx, k.y + dy, k.z + dz});
+          if (it == grid.end()) continue;
+          for (const Vec3& q : it->second)
+            if ((q - p).norm() < d * (1 - 1e-9)) return false;
+        }
+    return true;
+  };
+  static const Real basis[4][3] = {{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}};
+  const Vec3 planePoint = s.tipL + s.upL * s.thickness;  // the shovel plane: the cutting plane + the blade
+  const MaterialRef previous = gbs.getMaterial();
+  struct Site {
+    Real above;
+    Vec3 p;
+  };
+  std::vector<Site> sites;
+  for (size_t j = j0; j <= j1; ++j)
+    for (size_t i = i0; i <= i1; ++i) {
+      const size_t v = j * nx_ + i;
+      if (pending_[v] < V) continue;
+      // Sites whose (x, y) lie in this vertex's cell column [x_v - dx/2, x_v + dx/2) x [y_v - dy/2, y_v + dy/2).
+      const Real cx0 = (Real(i) - 0.5) * dx_, cx1 = (Real(i) + 0.5) * dx_;
+      const Real cy0 = (Real(j) - 0.5) * dy_, cy1 = (Real(j) + 0.5) * dy_;
+      const Real h = heightField_->getHeight(i, j);
+      const Real zStart = std::min(h, planePoint.z() - 2 * std::max(dx_, dy_));
+      const long long kz0 = (long long)std::floor(zStart / a) - 1;
+      sites.clear();
+      for (long long kx = (long long)std::floor(cx0 / a) - 1; kx <= (long long)std::ceil(cx1 / a); ++kx)
+        for (long long ky = (long long)std::floor(cy0 / a) - 1; ky <= (long long)std::ceil(cy1 / a); ++ky)
+          for (long long kz = kz0; kz < kz0 + 64; ++kz)
+            for (const auto& b : basis) {
+              const Real u = (Real(kx) + b[0]) * a, w = (Real(ky) + b[1]) * a;
+              if (!(u >= cx0 && u < cx1 && w >= cy0 && w < cy1)) continue;
+              const Vec3 p(x0 + u, y0 + w, (Real(kz) + b[2]) * a);
+              const Real above = (p - planePoint).dot(s.upL);
+              if (!(above >= r) || !(p.z() >= h + r)) continue;
+              // Clear of the ground around it: r above the highest corner of the cell holding the site (a site
+              // in a cut column next to uncut ground would otherwise start inside the slope and fall through).
+              {
+                const size_t ci = std::min(size_t(std::max<Real>(0, u / dx_)), nx_ - 2);
+                const size_t cj = std::min(size_t(std::max<Real>(0, w / dy_)), ny_ - 2);
+                const Real top = std::max(std::max(heightField_->getHeight(ci, cj), heightField_->getHeight(ci + 1, cj)),
+                                          std::max(heightField_->getHeight(ci, cj + 1), heightField_->getHeight(ci + 1, cj + 1)));
+                if (!(p.z() >= top + r)) continue;
+              }
+              const Vec3 pw = T.apply(p);
+              if (!(pw.x() >= s.box.lo.x() && pw.x() <= s.box.hi.x() && pw.y() >= s.box.lo.y() &&
+                    pw.y() <= s.box.hi.y()))
+                continue;
+              sites.push_back({above, p});
+            }
+      std::sort(sites.begin(), sites.end(), [](const Site& l, const Site& rr) {
+        return l.above < rr.above || (l.above == rr.above && l.p.z() < rr.p.z());
+      });
+      gbs.setMaterial(particleMaterial(v));
+      for (const Site& site : sites) {
+        if (pending_[v] < V) break;
+        if (!free(site.p)) continue;
+        const Vec3 pw = T.apply(site.p);
+        const Vec3 vel = s.body ? s.body->getVelocityAt(pw) : Vec3::Zero();
+        const size_t id = gbs.createParticle(pw, r, vel);
+        gbs.setCustomReal(ParticleVolumeBuffer, id, V);
+        particles_.emplace_back(id, V);
+        grid[keyOf(site.p)].push_back(site.p);
+        pending_[v] -= V;
+        ledger_.pending -= V;
+        ledger_.particles += V;
+        ++digStats_.particlesCreated;
+      }
+    }
+  gbs.setMaterial(previous);
+}
+
+void Terrain::mergeParticles(const std::vector<Shovel>& shovels) {
+  if (particles_.empty()) return;
+  GranularBodySystem& gbs = getSimulation()->getGranularBodySystem();
+  const Transform& T = geometry_->getTransform();
+  TerrainDataInterface& di = *data_;
+  const Real M = di.maxMultiplier_, D = di.depthForMax_;
+  const Real v2 = mergeVelocity_ * mergeVelocity_;
+  size_t keep = 0;
+  for (size_t k = 0; k < particles_.size(); ++k) {
+    const auto [id, V] = particles_[k];
+    if (!gbs.isValid(id)) {
+      // Destroyed by someone else: its soil left the simulation.
+      ledger_.particles -= V;
+      ledger_.removed += V;
+      ++digStats_.particlesRemoved;
+      continue;
+    }
+    bool merge = mergeVelocity_ > 0 && gbs.getVelocity(id).squaredNorm() < v2;
+    const Vec3 pw = gbs.getPosition(id);
+    for (size_t s = 0; merge && s < shovels.size(); ++s) {
+      const Aabb& z = shovels[s].zone;
+      if (pw.x() >= z.lo.x() && pw.x() <= z.hi.x() && pw.y() >= z.lo.y() && pw.y() <= z.hi.y() &&
+          pw.z() >= z.lo.z() && pw.z() <= z.hi.z())
+        merge = false;
+    }
+    size_t vv[3];
+    Real w[3];
+    if (merge) {
+      const Vec3 p = T.applyInverse(pw);
+      merge = locate(p, vv, w);
+      if (merge) {
+        // Resting near the surface: its bottom within one diameter of the ground under it.
+        const std::vector<Real>& hs = heightField_->getHeights();
+        const Real surface = w[0] * hs[vv[0]] + w[1] * hs[vv[1]] + w[2] * hs[vv[2]];
+        const Real r = gbs.getRadius(id);
+        merge = p.z() - r <= surface + 2 * r;
+        Real sum = 0;
+        for (int q = 0; q < 3; ++q) {
+          if (lockedBorders_ && isBorderVertex(vv[q] % nx_, vv[q] / nx_)) w[q] = 0;
+          sum += w[q];
+        }
+        if (!(sum > 0)) merge = false;
+        else
+          for (Real& wq : w) wq /= sum;
+      }
+    }
+    if (!merge) {
+      particles_[keep++] = particles_[k];
+      continue;
+    }
+    for (int q = 0; q < 3; ++q) {
+      if (!(w[q] > 0)) continue;
+      const size_t v = vv[q], x = v % nx_, y = v / nx_;
+      const Real dz = w[q] * V / getVertexArea(x, y);
+      heightField_->setHeight(x, y, heightField_->getHeight(x, y) + dz);
+      // Fresh loose soil on top: c falls by the compression rule (not below 0).
+      const Real d = di.deformabilityOf(v);
+      if (d > 0 && M > 1) {
+        di.compression_[v] = std::max<Real>(0, di.compression_[v] - dz * std::log2(M) / D);
+        di.multiplier_[v] = TerrainDataInterface::multiplier(di.compression_[v], d, M);
+      }
+    }
+    ledger_.particles -= V;
+    ledger_.heightField += V;
+    digStats_.volumeMerged += V;
+    ++digStats_.particlesMerged;
+    gbs.destroyParticle(id);
+  }
+  particles_.resize(keep);
+}
+
+}  // namespace scree
