@@ -2,12 +2,18 @@
 // its tip down, and the heap merges back into the height field. Prints per phase the particles created and
 // merged, the live particles, and the soil-volume ledger (its total stays constant: digging moves soil
 // heightField -> pending -> particles -> heightField, it never creates or loses any).
+//
+//   build/examples/terrain_dig_trench [DIR]   with DIR: after each phase writes DIR/<phase>_surface.dat (x, z of
+//   the terrain surface along y = 0), DIR/<phase>_particles.dat (x, z of the particles with |y| < 0.15 m) and
+//   DIR/<phase>_bucket.dat (the blade and back plate outlines in the x-z plane); docs/terrain/dig.gp plots them.
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include <scree/scree.h>
 
-int main() {
+int main(int argc, char** argv) {
+  const std::string dir = argc > 1 ? argv[1] : "";
   using namespace scree;
   Simulation sim;
   sim.setTimeStep(1.0 / 60);
@@ -72,6 +78,36 @@ int main() {
     std::printf("%-7s %8zu %8zu %6zu %12.6f %12.6f %12.6f %12.6f %10.1e\n", p.name, created, merged,
                 sim.getGranularBodySystem().numParticles(), l.heightField, l.pending, l.particles, l.total(),
                 (l.total() - total0) / total0);
+    if (!dir.empty()) {
+      // Side view (x-z plane through y = 0) of this phase's end: surface, particles, bucket.
+      const std::string base = dir + "/" + p.name;
+      if (std::FILE* f = std::fopen((base + "_surface.dat").c_str(), "w")) {
+        for (size_t i = 0; i < n; ++i) {
+          const Vec3 v = terrain->getGeometry()->getTransform().apply(hf->getVertex(i, n / 2));
+          std::fprintf(f, "%.4f %.4f\n", v.x(), v.z());
+        }
+        std::fclose(f);
+      }
+      if (std::FILE* f = std::fopen((base + "_particles.dat").c_str(), "w")) {
+        sim.getGranularBodySystem().forEachParticle([&](size_t id) {
+          const Vec3 x = sim.getGranularBodySystem().getPosition(id);
+          if (std::abs(x.y()) < 0.15) std::fprintf(f, "%.4f %.4f\n", x.x(), x.z());
+        });
+        std::fclose(f);
+      }
+      if (std::FILE* f = std::fopen((base + "_bucket.dat").c_str(), "w")) {
+        for (const GeometryRef& g : bucket->getGeometries()) {
+          const Vec3 he = static_cast<const Box&>(*g->getShape()).getHalfExtents();
+          for (int k = 0; k <= 4; ++k) {
+            const Real sx = (k == 1 || k == 2) ? 1 : -1, sz = (k >= 2 && k <= 3) ? 1 : -1;
+            const Vec3 c = g->getTransform().apply(Vec3(sx * he.x(), 0, sz * he.z()));
+            std::fprintf(f, "%.4f %.4f\n", c.x(), c.z());
+          }
+          std::fprintf(f, "\n");
+        }
+        std::fclose(f);
+      }
+    }
   }
   return 0;
 }
