@@ -100,13 +100,15 @@ TEST_SUITE("suction") {
     }
   }
 
-  TEST_CASE("a sealed cup lifts 80 % of its capacity from rest at 0.1 m/s; 120 % stays down") {
+  TEST_CASE("a sealed cup lifts 80, 90 and 95 % of its capacity from rest at 0.1 m/s; 120 % stays down") {
     // The box rests on a table with its top face at the lip; the holder (kinematic) waits 0.5 s, then rises at
     // 0.1 m/s for 2 s. Sealed, the cup pulls with dp A whatever the millimetre gap the start of the lift opens
-    // (suction_gripper.h: no distance fade without leakage), so 80 % rises with the holder.
+    // (suction_gripper.h: no distance fade without leakage), so every payload below capacity rises with the
+    // holder. With the fade applied to sealed cups (the old law) 90 % and 95 % stayed on the table in this rig
+    // (80 % still rose: here the gap stays under the ~3 mm at which (r_l / (r_l + d))^2 drops below 0.8).
     const Real v = 0.6, pa = 101325;
     const Real capacity = v * pa * lipArea() / kG;
-    for (Real factor : {0.8, 1.2}) {
+    for (Real factor : {0.8, 0.9, 0.95, 1.2}) {
       CAPTURE(factor);
       TestWorld w(1.0 / 60, kG);
       Rig rig(w, v);
