@@ -99,4 +99,28 @@ TEST_CASE("a ball dropped from 1 m with restitution e rebounds to e^2 m within 5
   }
 }
 
+// may_fail: not yet (13.6 mm measured). Gauss-Seidel over the four normal rows of the impact gives unequal
+// impulses, a torque (docs/solver-internals.md "Resting stacks": a manifold block solve removes it but is not in).
+TEST_CASE("a box dropped flat with restitution 0.5 bounces straight: sideways drift under 1 mm" *
+          doctest::may_fail()) {
+  // A 0.6 m cube dropped flat from 1 m onto the ground (restitution 0.5, mu 0.5, default solver settings): by
+  // symmetry nothing acts sideways, so every bounce must land where the first one did.
+  TestWorld w(1.0 / 60.0, kG, 0.5, 0.5);
+  w.sim->getSolver().setNumIterations(Simulation().getSolver().getNumIterations());
+  w.addGround();
+  auto box = w.addBox(Vec3(0.3, 0.3, 0.3), Vec3(0, 0, 1.3), 216.0);
+  Real maxDrift = 0, apex = 0;
+  bool landed = false;
+  for (int i = 0; i < 300; ++i) {
+    w.steps(1);
+    const Vec3 p = box->getPosition();
+    maxDrift = std::max(maxDrift, p.head<2>().norm());
+    if (box->getVelocity().z() > 0) landed = true;
+    if (landed) apex = std::max(apex, p.z() - 0.3);
+  }
+  MESSAGE("bounce: first apex " << apex << " m, sideways drift " << maxDrift * 1e3 << " mm over 5 s");
+  CHECK(apex > 0.1);  // it did bounce (e^2 of 1 m is 0.25 m)
+  CHECK(maxDrift < 1e-3);
+}
+
 }  // TEST_SUITE

@@ -68,6 +68,10 @@ TEST_CASE("iteration sweep: more PGS sweeps never make the stacks worse (5 to 64
   //   pyramid20 drift   1.87    1.06    0.34    0.25    0.10 cm
   //   mass_ratio worst  79.0    55.0    27.9    25.6    24.1 um  (heavy box below 1.5 m, worst over the run)
   //   tower10 drift     15      33      16      12      2.2 um
+  // Since the warm start matches points whose feature id changed by position (contact_rows.h), mass_ratio's
+  // warm start is no longer lost, and its worst error sits at the compliance floor from 5 iterations on:
+  // 23.81, 23.83, 23.82, 23.82, 23.84 um (pyramid20 1.42, 0.41, 0.18, 0.08, 0.05 cm). Those differ by less than
+  // 0.1 um, 0.4 % of the sink: the error then only has to stay within 0.1 um of the previous count's.
   // Asserted: pyramid20's drift and mass_ratio's worst heavy error fall with every step of the sweep; at 64
   // iterations pyramid20's drift is under a tenth of its 5-iteration value (measured 1/18) and the heavy box's
   // worst error is within 10 % of the compliance sink, (1000 + 1001) kg g / (4 E) = 24.5 um for E = 2e8 N/m per
@@ -105,7 +109,7 @@ TEST_CASE("iteration sweep: more PGS sweeps never make the stacks worse (5 to 64
     CHECK(tower[k].maxDisplacement < 1e-4);
     if (k > 0) {
       CHECK(pyr[k].maxDisplacement < pyr[k - 1].maxDisplacement);
-      CHECK(mr[k].heavyErrorWorst < mr[k - 1].heavyErrorWorst);
+      CHECK(mr[k].heavyErrorWorst < mr[k - 1].heavyErrorWorst + 1e-7);
     }
   }
   CHECK(pyr[n - 1].maxDisplacement < 0.1 * pyr[0].maxDisplacement);

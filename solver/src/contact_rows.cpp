@@ -78,7 +78,7 @@ void buildContactRows(SimulationState& s) {
       ++numPoints;
       const Vec3& n = p.normal;
       const Vec3 ra = p.point - xa, rb = p.point - xb;
-      const WarmStartCache::Entry* ce = warm ? s.warmStart.find(pair, p.featureId) : nullptr;
+      const WarmStartCache::Entry* ce = warm ? s.warmStart.find(pair, p.featureId, p.point) : nullptr;
       if (ce) ++numWarm;
 
       // --- normal row (contact_law.h) ---

@@ -191,6 +191,32 @@ const std::vector<ParticleContact>& Simulation::getParticleGeometryContacts() co
 const StepStats& Simulation::getStepStats() const { return s_->stats; }
 const StepReport& Simulation::getLastStepReport() const { return s_->report; }
 
+StepTimings Simulation::getTimings() const {
+  const StepStats& t = s_->stats;
+  const double ms = 1e3;
+  StepTimings r;
+  r.preCollide = t.preCollide * ms;
+  r.syncGeometries = t.syncGeometries * ms;
+  r.collideGeometries = t.collideGeometries * ms;
+  r.collideParticles = t.collideParticles * ms;
+  r.resolveMaterials = t.resolveMaterials * ms;
+  r.contactEvents = t.contactEvents * ms;
+  r.pre = t.pre * ms;
+  r.applyForces = t.applyForces * ms;
+  r.contactRows = t.contactRows * ms;
+  r.constraintRows = t.constraintRows * ms;
+  r.particleRows = t.particleRows * ms;
+  r.solve = t.solve * ms;
+  r.integrateMotion = t.integrateMotion * ms;
+  r.storeResults = t.storeResults * ms;
+  r.projectPositions = t.projectPositions * ms;
+  r.checkFinite = t.checkFinite * ms;
+  r.post = t.post * ms;
+  r.compactParticles = t.compactParticles * ms;
+  r.total = t.total * ms;
+  return r;
+}
+
 // ---- the step ----------------------------------------------------------------------------------------------
 
 void Simulation::stepForward() {

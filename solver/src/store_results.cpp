@@ -18,7 +18,7 @@ void storeResults(SimulationState& s) {
     p.normalForce = ln * invH;
     p.frictionForce = ft * invH;
     p.impactSpeed = pr.impactSpeed;
-    s.warmStart.add({contactPairKey(c), p.featureId, ln, ft, pr.impactSpeed});
+    s.warmStart.add({contactPairKey(c), p.featureId, ln, ft, pr.impactSpeed, p.point});
   }
   s.warmStart.commit();
   for (const auto& r : s.ranges) r.c->storeResult(s.rows.data() + r.begin, s.rowDofs.data() + r.begin, r.count, s.h);

@@ -26,11 +26,12 @@
 //                   speed far away:  P_a = P_m + rho v_m^2 / 2,  v_l = v_m a_m / a_l,  P_l = P_a - rho v_l^2 / 2,
 //                   a = pi r^2, i.e. P_a - P_l = (P_a - P_m)(r_m / r_l)^4 (capped at P_a - P_m when r_m > r_l).
 //   available force F = (P_a - P_l) pi r_l^2
-//   on the body     F_body = F * fraction * (r_l / (r_l + d))^2 along the cup normal (towards the cup, i.e. minus
-//                   the line sensor direction), applied at the surface point the line sensor found; d >= 0 is the
-//                   distance along the line sensor from the lip to that point. The factor is our reading of the
-//                   manual's "pressure gradient decays quadratically relative to the distance from the suction cup
-//                   center": 1 at the lip, ~ (r_l / d)^2 far away.
+//   on the body     F_body = F * fraction * fade along the cup normal (towards the cup, i.e. minus the line
+//                   sensor direction), applied at the surface point the line sensor found. A leaking cup has
+//                   fade = (r_l / (r_l + d))^2, d >= 0 the distance along the line sensor from the lip to that
+//                   point: our reading of the manual's "pressure gradient decays quadratically relative to the
+//                   distance from the suction cup center", 1 at the lip, ~ (r_l / d)^2 far away. The manual
+//                   derives that gradient from the flow of a leaking cup; a sealed cup has no flow: fade = 1.
 //   reaction        -F_body on the cup body at the same point. For a cup mounted by add(cup, pose) (an enabled
 //                   LockJoint to the holder) the reaction goes straight to the holder at that point: the same wrench
 //                   on the locked assembly, but it spares the solver a light cup body (20 g by default) loaded

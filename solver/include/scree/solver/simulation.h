@@ -66,6 +66,38 @@ struct StepStats {
   size_t numParticleContacts = 0;  ///< particle-particle plus solved particle-geometry contact points
 };
 
+/// The stage times of the last step in milliseconds (StepStats holds the same in seconds), for users reading
+/// where a step's time goes (as Box2D's b2Profile and AGX's timing statistics). One field per stage, in step
+/// order; the stages run back to back, so they add up to `total` (to the clock's resolution). Broadphase and
+/// narrowphase are one stage (`collideGeometries`): the Space runs them together.
+struct StepTimings {
+  double preCollide = 0;         ///< ms, PRE_COLLIDE step listeners
+  double syncGeometries = 0;     ///< ms, geometry additions and removals reach the Space
+  double collideGeometries = 0;  ///< ms, broadphase and narrowphase of the geometries
+  double collideParticles = 0;   ///< ms, particle collision
+  double resolveMaterials = 0;   ///< ms, contact materials and friction models
+  double contactEvents = 0;      ///< ms, contact listeners (geometry and particle contacts)
+  double pre = 0;                ///< ms, PRE_STEP step listeners
+  double applyForces = 0;        ///< ms, external forces into free velocities
+  double contactRows = 0;        ///< ms, contact row build (with warm start)
+  double constraintRows = 0;     ///< ms, joint and model row build
+  double particleRows = 0;       ///< ms, particle contact units
+  double solve = 0;              ///< ms, the velocity solve: PGS, DIRECT / hybrid, particle sweeps, shock passes
+  double integrateMotion = 0;    ///< ms, positions and rotations
+  double storeResults = 0;       ///< ms, contact forces, warm-start caches, constraint results
+  double projectPositions = 0;   ///< ms, post-step position projection
+  double checkFinite = 0;        ///< ms, non-finite check
+  double post = 0;               ///< ms, POST_STEP step listeners (models' post-step work included)
+  double compactParticles = 0;   ///< ms, deferred particle destroys
+  double total = 0;              ///< ms, the whole step
+  /// Sum of the stage fields (everything but `total`).
+  double sumOfStages() const {
+    return preCollide + syncGeometries + collideGeometries + collideParticles + resolveMaterials + contactEvents +
+           pre + applyForces + contactRows + constraintRows + particleRows + solve + integrateMotion +
+           storeResults + projectPositions + checkFinite + post + compactParticles;
+  }
+};
+
 /// Problems found in the last step.
 struct StepReport {
   /// Ids and names of bodies whose state became non-finite (they were restored and stopped).
@@ -156,6 +188,8 @@ class Simulation {
   const std::vector<ParticleContact>& getParticleParticleContacts() const;
   const std::vector<ParticleContact>& getParticleGeometryContacts() const;
   const StepStats& getStepStats() const;
+  /// The last step's stage times in milliseconds (StepTimings); all zero before the first step.
+  StepTimings getTimings() const;
   const StepReport& getLastStepReport() const;
 
  private:
