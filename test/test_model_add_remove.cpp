@@ -15,14 +15,8 @@ using scree::test::TestWorld;
 
 namespace {
 
-struct Snapshot {
-  size_t bodies, geometries, constraints, stepListeners, contactListeners, models;
-  bool operator==(const Snapshot&) const = default;
-};
-Snapshot snapshot(const Simulation& sim) {
-  return {sim.getRigidBodies().size(), sim.getStaticGeometries().size(), sim.getConstraints().size(),
-          sim.getStepEventListeners().size(), sim.getContactEventListeners().size(), sim.getModels().size()};
-}
+using test::Snapshot;
+using test::snapshot;
 
 bool contains(const std::vector<RigidBodyRef>& list, const RigidBodyRef& b) {
   return std::find(list.begin(), list.end(), b) != list.end();

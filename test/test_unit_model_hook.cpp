@@ -45,14 +45,8 @@ struct EverythingModel : Model {
   void onRemove(Simulation&) override { ++removedCalls; }
 };
 
-struct Snapshot {
-  size_t bodies, geometries, constraints, stepListeners, contactListeners, models;
-  bool operator==(const Snapshot&) const = default;
-};
-Snapshot snapshot(const Simulation& sim) {
-  return {sim.getRigidBodies().size(), sim.getStaticGeometries().size(), sim.getConstraints().size(),
-          sim.getStepEventListeners().size(), sim.getContactEventListeners().size(), sim.getModels().size()};
-}
+using test::Snapshot;
+using test::snapshot;
 
 }  // namespace
 

@@ -14,6 +14,17 @@
 
 namespace scree::test {
 
+/// What a simulation holds, by count: the model-hook tests compare it before a model is added and after it is
+/// removed.
+struct Snapshot {
+  size_t bodies, geometries, constraints, stepListeners, contactListeners, models;
+  bool operator==(const Snapshot&) const = default;
+};
+Snapshot snapshot(const Simulation& sim) {
+  return {sim.getRigidBodies().size(), sim.getStaticGeometries().size(), sim.getConstraints().size(),
+          sim.getStepEventListeners().size(), sim.getContactEventListeners().size(), sim.getModels().size()};
+}
+
 struct TestWorld : scenes::Scene {
   /// dt, gravity along -z (9.81 by default; 0 for none), friction and restitution of the contact material.
   explicit TestWorld(Real dt = 1.0 / 60.0, Real g = 9.81, Real mu = 0.5, Real restitution = 0.0) {
