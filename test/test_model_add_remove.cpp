@@ -15,8 +15,8 @@ using scree::test::TestWorld;
 
 namespace {
 
-using test::Snapshot;
-using test::snapshot;
+using Snapshot = test::SimulationCounts;
+inline Snapshot snapshot(const Simulation& sim) { return test::countsOf(sim); }
 
 bool contains(const std::vector<RigidBodyRef>& list, const RigidBodyRef& b) {
   return std::find(list.begin(), list.end(), b) != list.end();

@@ -45,8 +45,8 @@ struct EverythingModel : Model {
   void onRemove(Simulation&) override { ++removedCalls; }
 };
 
-using test::Snapshot;
-using test::snapshot;
+using Snapshot = test::SimulationCounts;
+inline Snapshot snapshot(const Simulation& sim) { return test::countsOf(sim); }
 
 }  // namespace
 

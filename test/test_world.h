@@ -16,11 +16,11 @@ namespace scree::test {
 
 /// What a simulation holds, by count: the model-hook tests compare it before a model is added and after it is
 /// removed.
-struct Snapshot {
+struct SimulationCounts {
   size_t bodies, geometries, constraints, stepListeners, contactListeners, models;
-  bool operator==(const Snapshot&) const = default;
+  bool operator==(const SimulationCounts&) const = default;
 };
-Snapshot snapshot(const Simulation& sim) {
+inline SimulationCounts countsOf(const Simulation& sim) {
   return {sim.getRigidBodies().size(), sim.getStaticGeometries().size(), sim.getConstraints().size(),
           sim.getStepEventListeners().size(), sim.getContactEventListeners().size(), sim.getModels().size()};
 }
