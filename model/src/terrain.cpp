@@ -396,6 +396,8 @@ void Terrain::postStep() {
   }
   for (size_t v : loaded_) load_[v] = stiffness_[v] = 0;
   loaded_.clear();
+  // 4. Avalanches of the armed vertices (terrain_avalanche.cpp; nothing while none is armed).
+  avalancheStep();
   lastPostTime_ = secondsSince(t0);
 }
 

@@ -426,6 +426,7 @@ void Terrain::mergeParticles(const std::vector<Shovel>& shovels) {
         di.multiplier_[v] = TerrainDataInterface::multiplier(di.compression_[v], d, M);
       }
     }
+    armAvalancheAt(vv);  // merged soil may stand steeper than repose (terrain_avalanche.cpp)
     ledger_.particles -= V;
     ledger_.heightField += V;
     digStats_.volumeMerged += V;

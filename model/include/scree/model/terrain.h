@@ -144,11 +144,75 @@
 // particles -> heightField. A terrain particle the user destroys moves its volume particles -> removed.
 // Not in this part: external materials, the particle Young's multiplier, the ground cutting force, the DIRECT
 // particle friction solve type, the bucket fill and digging force read-outs.
+//
+// ---------------------------------------------------------------------------------------------------------------
+// Dynamic height field: avalanches and the angle of repose (manual 25.1.2.15, 25.1.2.19, 25.1.2.20)
+// ---------------------------------------------------------------------------------------------------------------
+// setEnableDynamicHeightField(true) turns avalanches on (off by default). Deformer contacts (geometries with the
+// bool property DynamicHeightFieldDeformer, manual 25.1.2.15-25.1.2.18) are NOT built yet: for now the switch
+// only runs avalanches, armed by merging particles and by armAvalanche(x, y). avalancheAll() works either way.
+//
+// Arming. A vertex is armed for the avalanche step life time L (setAvalancheStepLifeTime, steps) when a particle
+// merges into it (its three vertices; later also where a deformer touches), or when armAvalanche(x, y) is called
+// (not in the manual: for user edits and tests). Arming a vertex also arms every vertex within the vertex
+// distance extent e (setAvalancheVertexDistanceExtent; the manual's misspelt setAvalanceVertexDistanceExtent too)
+// counted in vertices along x and y: the (2e+1) x (2e+1) square around it, clipped to the grid - the vertices
+// reachable in e hops over the 8-neighbour links the avalanche uses. Re-arming an armed vertex restores L (the
+// larger life wins). Arming does nothing (returns 0) while the dynamic height field is off.
+//
+// The pass (post step, after compression; once per step). Each armed vertex v with k steps left looks at its 8
+// neighbours n (x, y and diagonal; 8 rather than 4 so that diagonals obey the repose limit too - with 4, a
+// diagonal pair could stand at 2 tan(theta) s over s sqrt2, 41 % steeper). For the pair, with `hi` the higher
+// and `lo` the lower vertex, ell the distance (dx, dy or sqrt(dx^2 + dy^2)) and theta = theta(hi), the angle of
+// repose of the uphill vertex (the soil that would slide),
+//     excess = (h_hi - h_lo) - tan(theta) ell.
+// If excess > 0 (above a rounding tolerance of 1e-12 ell + 1e-14 (|h_hi| + |h_lo|)), the volume
+//     V = 2 decay excess A_hi A_lo / (A_hi + A_lo)            (A: trapezoid vertex areas, as in the ledger)
+// moves from hi to lo: h_hi -= V / A_hi, h_lo += V / A_lo. Volume, not height, is conserved (edge and corner
+// vertices hold 1/2 and 1/4 of an inner vertex's area). With equal areas each vertex moves decay x excess,
+// so decay 0.5 (the manual's maximum) leaves the pair exactly at the repose difference in one step and decay 0
+// moves nothing (the manual: "at 0 there will be no avalanches"). Pairs are taken one after the other with the
+// heights as they are (Gauss-Seidel): a vertex with several lower neighbours gives to each in turn, never more
+// than brings that pair to repose, so no pass overshoots into a reversed slope steeper than the one it removed
+// (each move lowers the potential energy; the process cannot cycle). The moves arm both vertices of the pair
+// with k - 1 steps (unless they have more), so an avalanche spreads as far as the soil runs but dies out L
+// steps after the arming that started it: an arming runs exactly L passes. Then v has k - 1 steps left.
+//
+// Locked borders. A locked border vertex never changes height: it gives no soil, and soil moving onto it is
+// held back (no move) or, with avalancheMassLoss (setEnableLockedBorders' second argument, default true), lost
+// over the border: V = 2 decay excess A_hi leaves hi (so decay 0.5 brings hi to repose against the fixed border
+// height) and is booked heightField -> lostAtBorder. Without locked borders the border vertices are ordinary
+// vertices and no soil leaves the grid.
+//
+// Compression of moved soil. The receiving vertex gets fresh loose soil on top: its c falls by
+// dz log2(M) / D (dz = V / A_lo; not below 0), as for merged particles. The giving vertex keeps its c: an
+// avalanche strips the loose top layer and does not compact what lies beneath (lowering by digging or
+// pressing does raise c - they remove or press soil, a slide does neither).
+//
+// The angle of repose. theta0 = the material's angleOfRepose (TerrainDataInterface::add), or atan(mu) of the
+// vertex material's friction coefficient (Material::getFrictionCoefficient; an infinite mu gives pi/2: it
+// never slides) when that is 0. Wetness w (setWetnessScale, in [0, 1], default 0) makes compacted soil stand
+// steeper, linearly in the compression relative to max compression (manual 25.1.2.20):
+//     theta(c) = theta0 + w (c / c_max) (pi/2 - theta0) / 2         (c / c_max clamped to [0, 1])
+// i.e. fully compacted, fully wet soil stands halfway between its dry angle and vertical (dry sand 34 deg ->
+// 62 deg), never past pi/2; w = 0 (dry) or non-deformable ground (d = 0 or M = 1, c_max = 0) keeps theta0 at
+// every compression. computeAngleOfRepose(x, y) returns the angle the pass uses at a vertex.
+//
+// avalancheAll(maxIterations) relaxes the whole field to repose now (imported or user-made terrain): passes
+// over a work list, starting with every vertex, with the full move (decay 0.5, whatever the set decay), each
+// pass holding only the vertices whose height changed in the previous one; it stops when a pass moves nothing
+// (converged: every pair within repose up to the rounding tolerance) or after maxIterations passes. Locked
+// borders and mass loss apply; nothing is armed.
+//
+// Cost. Armed vertices live in a sparse list (each with its steps left); a step's pass visits them and their 8
+// neighbours, nothing else - no pass over the grid unless avalancheAll is called. Height edits are batched by
+// cluster as for compression, so only the touched tiles' bounds are updated.
 #pragma once
 
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <utility>
@@ -180,6 +244,16 @@ struct TerrainDigStats {
   size_t particlesRemoved = 0;  ///< terrain particles found destroyed by someone else (volume booked removed)
   Real volumeDug = 0;           ///< m^3 cut out of the height field (heightField -> pending)
   Real volumeMerged = 0;        ///< m^3 merged back (particles -> heightField)
+};
+
+/// What avalanches did: in the last step's pass (Terrain::getLastStepAvalancheStats) or in one avalancheAll call.
+struct TerrainAvalancheStats {
+  size_t passes = 0;       ///< passes over the armed (or work) list
+  size_t visited = 0;      ///< vertex visits over all passes
+  size_t moves = 0;        ///< pair moves (soil moved from a vertex to a neighbour or over a locked border)
+  Real volumeMoved = 0;    ///< m^3 moved between vertices
+  Real volumeLost = 0;     ///< m^3 lost over locked borders (heightField -> lostAtBorder)
+  bool converged = false;  ///< avalancheAll: the last pass moved nothing (every pair within repose)
 };
 
 class Terrain;
@@ -283,6 +357,44 @@ class Terrain : public Model {
   Real getParticleCarriedVolume(size_t id) const;
   const TerrainDigStats& getLastStepDigStats() const { return digStats_; }
 
+  // --- dynamic height field: avalanches and the angle of repose (file comment) ------------------------------------
+  /// Turns the dynamic height field on or off (default off). On: armed vertices avalanche every step. Deformer
+  /// contacts (DynamicHeightFieldDeformer) are not built yet. Turning it off disarms every vertex.
+  void setEnableDynamicHeightField(bool enable);
+  bool getEnableDynamicHeightField() const { return dynamicHeightField_; }
+  static constexpr int defaultAvalancheStepLifeTime = 100;
+  static constexpr Real defaultAvalancheDecayPercent = 0.1;
+  static constexpr int defaultAvalancheVertexDistanceExtent = 2;
+  /// Steps an arming lasts (>= 0; 0: arming does nothing). Otherwise std::invalid_argument, unchanged.
+  void setAvalancheStepLifeTime(int numSteps);
+  int getAvalancheStepLifeTime() const { return avalancheLifeTime_; }
+  /// Fraction in [0, 0.5] (finite): 0 no avalanches, 0.5 a single pair reaches repose in one step.
+  void setAvalancheDecayPercent(Real decay);
+  Real getAvalancheDecayPercent() const { return avalancheDecay_; }
+  /// Vertices armed around an armed vertex, counted along x and y (>= 0).
+  void setAvalancheVertexDistanceExtent(int numVertices);
+  /// The manual's spelling of setAvalancheVertexDistanceExtent.
+  void setAvalanceVertexDistanceExtent(int numVertices) { setAvalancheVertexDistanceExtent(numVertices); }
+  int getAvalancheVertexDistanceExtent() const { return avalancheExtent_; }
+  /// Wetness in [0, 1] (finite): 0 dry (the angle of repose is the same at any compression), 1 fully wet.
+  void setWetnessScale(Real scale);
+  Real getWetnessScale() const { return wetness_; }
+  /// The angle of repose (rad) the avalanche uses at vertex (x, y): theta(c) of the file comment.
+  Real computeAngleOfRepose(size_t x, size_t y) const;
+  /// Arms vertex (x, y) and the vertices within the extent for the life time (not in the manual: for user edits
+  /// and tests). Returns the number of vertices armed; 0 while the dynamic height field is off or L = 0.
+  size_t armAvalanche(size_t x, size_t y);
+  /// Steps of avalanching left at vertex (x, y) (0: not armed).
+  int getAvalancheStepsLeft(size_t x, size_t y) const;
+  size_t getNumArmedVertices() const { return armed_.size(); }
+  /// Relaxes the whole field to its angle of repose now, in at most maxIterations (>= 1) passes. Works whether
+  /// or not the dynamic height field is on; arms nothing.
+  static constexpr int defaultAvalancheAllIterations = 100000;
+  TerrainAvalancheStats avalancheAll(int maxIterations = defaultAvalancheAllIterations);
+  const TerrainAvalancheStats& getLastStepAvalancheStats() const { return avalancheStats_; }
+  /// Wall-clock time of the last step's avalanche pass, s (part of getLastStepTime()).
+  double getLastStepAvalancheTime() const { return lastAvalancheTime_; }
+
   /// Vertices loaded by contacts in the last step, and how many of them yielded.
   size_t getNumLoadedVertices() const { return numLoaded_; }
   size_t getNumYieldedVertices() const { return numYielded_; }
@@ -350,6 +462,29 @@ class Terrain : public Model {
   };
   std::vector<ParticleMaterialCache> particleMaterials_;
   TerrainDigStats digStats_;
+  // Avalanches (terrain_avalanche.cpp).
+  /// Arms the three vertices of a merged particle (and the extent around them); nothing while disabled.
+  void armAvalancheAt(const size_t (&v)[3]);
+  void armWithExtent(size_t v, int life);
+  void arm(size_t v, int life);
+  void avalancheStep();
+  Real reposeTangent(size_t v) const;
+  Real reposeAngle(size_t v) const;
+  /// Moves soil between vertices a and b (8-neighbours, distance ell) as the file comment says; factor =
+  /// 2 decay. Returns true when soil moved.
+  bool relaxPair(size_t a, size_t b, Real ell, Real factor, TerrainAvalancheStats& stats);
+  bool dynamicHeightField_ = false;
+  int avalancheLifeTime_ = defaultAvalancheStepLifeTime;
+  Real avalancheDecay_ = defaultAvalancheDecayPercent;
+  int avalancheExtent_ = defaultAvalancheVertexDistanceExtent;
+  Real wetness_ = 0;
+  std::vector<int> life_;            ///< per vertex: avalanche passes left (0: not armed)
+  std::vector<uint8_t> inList_;      ///< per vertex: listed in armed_ (or in avalancheAll's work list)
+  std::vector<size_t> armed_;        ///< the armed vertices (sparse)
+  TerrainAvalancheStats avalancheStats_;
+  double lastAvalancheTime_ = 0;
+  class EditBatch;
+  EditBatch* editBatch_ = nullptr;   ///< the open batch of height edits while avalanches run
 };
 using TerrainRef = std::shared_ptr<Terrain>;
 
