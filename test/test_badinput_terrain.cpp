@@ -154,4 +154,48 @@ TEST_SUITE("terrain bad input") {
     CHECK(t->getVolumeLedger().total() == doctest::Approx(t->computeHeightFieldVolume() +
                                                           t->getVolumeLedger().compressed));
   }
+  TEST_CASE("avalanche settings reject bad values and leave the terrain and the settings unchanged") {
+    TestWorld w;
+    TerrainRef t = addFlatTerrain(w, 6, 5.0);
+    t->setEnableDynamicHeightField(true);
+    t->setAvalancheStepLifeTime(7);
+    t->setAvalancheDecayPercent(0.3);
+    t->setAvalancheVertexDistanceExtent(1);
+    t->setWetnessScale(0.4);
+    t->getHeightField()->setHeight(2, 2, 3.0);
+    t->armAvalanche(2, 2);
+    const size_t armed = t->getNumArmedVertices();
+    auto settingsUnchanged = [&] {
+      CHECK(t->getAvalancheStepLifeTime() == 7);
+      CHECK(t->getAvalancheDecayPercent() == 0.3);
+      CHECK(t->getAvalancheVertexDistanceExtent() == 1);
+      CHECK(t->getWetnessScale() == 0.4);
+      CHECK(t->getEnableDynamicHeightField());
+      CHECK(t->getNumArmedVertices() == armed);
+      CHECK(t->getAvalancheStepsLeft(2, 2) == 7);
+    };
+    CHECK_REJECTED(t->setAvalancheDecayPercent(0.51), "decayScale = 0.51");
+    CHECK_REJECTED(t->setAvalancheDecayPercent(-0.01), "decayScale = -0.01");
+    CHECK_REJECTED(t->setAvalancheDecayPercent(kNaN), "decayScale = nan");
+    CHECK_REJECTED(t->setAvalancheDecayPercent(std::numeric_limits<Real>::infinity()), "decayScale = inf");
+    CHECK_REJECTED(t->setWetnessScale(1.5), "scale = 1.5");
+    CHECK_REJECTED(t->setWetnessScale(-0.1), "scale = -0.1");
+    CHECK_REJECTED(t->setWetnessScale(kNaN), "scale = nan");
+    CHECK_REJECTED(t->setAvalancheStepLifeTime(-1), "numSteps = -1");
+    CHECK_REJECTED(t->setAvalancheVertexDistanceExtent(-2), "numVertices = -2");
+    CHECK_REJECTED(t->setAvalanceVertexDistanceExtent(-1), "numVertices = -1");  // the manual's spelling
+    CHECK_REJECTED(t->armAvalanche(6, 0), "x = 6");
+    CHECK_REJECTED(t->armAvalanche(0, 6), "y = 6");
+    CHECK_REJECTED(t->computeAngleOfRepose(7, 0), "x = 7");
+    CHECK_REJECTED(t->getAvalancheStepsLeft(0, 9), "y = 9");
+    CHECK_REJECTED(t->avalancheAll(0), "maxIterations = 0");
+    settingsUnchanged();
+    // Accepted edge values.
+    CHECK_NOTHROW(t->setAvalancheDecayPercent(0));
+    CHECK_NOTHROW(t->setAvalancheDecayPercent(0.5));
+    CHECK_NOTHROW(t->setWetnessScale(0));
+    CHECK_NOTHROW(t->setWetnessScale(1));
+    CHECK_NOTHROW(t->setAvalancheStepLifeTime(0));
+    CHECK_NOTHROW(t->setAvalancheVertexDistanceExtent(0));
+  }
 }
