@@ -54,6 +54,25 @@ TerrainRef addAvalancheTerrain(TestWorld& w, size_t n) {
   return t;
 }
 
+/// A kinematic bucket as in test_model_terrain_dig.cpp: a bottom plate (the shovel; forward +x to its front
+/// edge, up +z) and a back plate.
+RigidBodyRef addBucket(TestWorld& w, const Vec3& at) {
+  auto body = std::make_shared<RigidBody>("bucket");
+  auto blade = std::make_shared<Geometry>(std::make_shared<Box>(Vec3(0.2, 0.15, 0.01)), "blade");
+  blade->setMaterial(w.material);
+  blade->getPropertyContainer().addPropertyVec3(Terrain::ShovelUpProperty, Vec3(0, 0, 0.02));
+  blade->getPropertyContainer().addPropertyVec3(Terrain::ShovelForwardProperty, Vec3(0.2, 0, 0));
+  body->add(blade);
+  auto back = std::make_shared<Geometry>(std::make_shared<Box>(Vec3(0.01, 0.15, 0.1)), "back");
+  back->setMaterial(w.material);
+  back->setLocalPosition(Vec3(-0.21, 0, 0.09));
+  body->add(back);
+  body->setMotionControl(RigidBody::KINEMATICS);
+  body->setPosition(at);
+  w.sim->add(body);
+  return body;
+}
+
 }  // namespace
 
 TEST_SUITE("terrain avalanche") {
@@ -362,5 +381,44 @@ TEST_SUITE("terrain avalanche") {
       CHECK(hf.getHeight(0, 5) > h0[5 * 11]);
       CHECK(t->getVolumeLedger().lostAtBorder == 0);
     }
+  }
+  TEST_CASE("merged particles arm avalanches around their vertices; the ledger holds every step") {
+    TestWorld w(1.0 / 60);
+    w.material->setRollingResistanceCoefficient(0.3);
+    TerrainRef t = addFlatTerrain(w, 41, 2.0);  // s = 0.05 m
+    t->getParticleAttributes().setParticleRadius(0.02);
+    t->setEnableDynamicHeightField(true);
+    t->setAvalancheVertexDistanceExtent(2);
+    RigidBodyRef bucket = addBucket(w, Vec3(-0.5, 0, 0.03));
+    const Real total0 = t->getVolumeLedger().total();
+    Real worstLedger = 0, moved = 0;
+    size_t merged = 0, mergeSteps = 0, armedAfterMerge = 0, minArmedAfterMerge = size_t(-1);
+    auto run = [&](Real seconds, const Vec3& v, const Vec3& omega) {
+      bucket->setVelocity(v);
+      bucket->setAngularVelocity(omega);
+      for (int i = 0; i < int(std::lround(seconds * 60)); ++i) {
+        w.sim->stepForward();
+        worstLedger = std::max(worstLedger, std::abs(t->getVolumeLedger().total() - total0) / total0);
+        moved += t->getLastStepAvalancheStats().volumeMoved;
+        if (t->getLastStepDigStats().particlesMerged > 0) {
+          merged += t->getLastStepDigStats().particlesMerged;
+          ++mergeSteps;
+          armedAfterMerge += t->getNumArmedVertices() > 0;
+          minArmedAfterMerge = std::min(minArmedAfterMerge, t->getNumArmedVertices());
+        }
+      }
+    };
+    run(0.5, Vec3(0, 0, -0.1), Vec3::Zero());   // tip 2 cm into the soil
+    run(0.5, Vec3(0.4, 0, 0), Vec3::Zero());    // a short trench: particles on the blade
+    run(0.3, Vec3(0, 0, 0.4), Vec3::Zero());    // lift
+    run(0.2, Vec3(0, 5.0, 0), Vec3::Zero());    // pulled out sideways from under them (no side walls)
+    run(2.0, Vec3::Zero(), Vec3::Zero());       // they land and merge
+    MESSAGE(merged << " particles merged in " << mergeSteps << " steps; avalanches moved " << moved
+                   << " m^3; ledger drift " << worstLedger);
+    REQUIRE(merged > 0);
+    CHECK(armedAfterMerge == mergeSteps);  // every merge armed (life time 100 steps: still armed after it)
+    CHECK(minArmedAfterMerge >= 25);       // at least one vertex's 5 x 5 extent
+    CHECK(moved > 0);  // the merged bumps stood steeper than atan(0.5) and slid (3.7e-5 m^3 measured)
+    CHECK(worstLedger <= 1e-9);
   }
 }
