@@ -26,7 +26,7 @@
 // Depth and compression. Lowering a vertex by dz (pressed by a contact; later dug or pushed) raises c by
 //     dc = dz * log2(M) / D          (D = the depth for max compression)
 // capped at c_max(d); raising a vertex lowers c by the same rule (fresh loose soil on top; not below 0; no
-// operation of this part raises vertices - merging and avalanches will). From
+// operation of this part raises vertices - merging and avalanches do, below). From
 // loose soil a vertex lowered by z has m = 2^((d+1) log2(M) z / D) = M^((d+1) z / D): it reaches M at depth
 // D / (d+1) <= D, so at D and deeper every material is as hard as M allows (manual 25.1.2.3), and a larger d
 // hardens exponentially faster (25.1.2.1).
@@ -95,57 +95,6 @@
 // (begin/endHeightEdit, one batch per cluster of nearby vertices), so only the touched tiles' bounds are updated.
 //
 // ---------------------------------------------------------------------------------------------------------------
-// Digging (manual 25.1.1.2, 25.1.2.6-25.1.2.9, 25.1.2.12; implemented here: shovels, the cut, particles, merging)
-// ---------------------------------------------------------------------------------------------------------------
-// Shovels. Any geometry in the simulation (on a body or static) with both Vec3 properties ShovelUpProperty and
-// ShovelForwardProperty (getPropertyContainer().addPropertyVec3) is a shovel; several may dig at once. Both
-// vectors are in the geometry's local frame: forward's length is the distance from the geometry's origin to the
-// cutting edge (the tip, origin + forward), up's length is the blade thickness; up must be orthogonal to forward
-// and point "up in the air" when the shovel rests on the ground. There is no setter to throw from, so a bad pair
-// (a zero or non-finite vector, |cos(up, forward)| > 1e-6, or a property of another type) is reported when the
-// terrain first sees the geometry - one Logger error naming the geometry and the problem - and the geometry is
-// not a shovel (isGeometryShovel is false, nothing is dug); fix the properties and it digs from the next step.
-//
-// The cut (a pre-collide step listener, before the step's contacts are found). Per shovel, in the height field's
-// frame: the cutting plane passes through the tip with normal up. Where the shovel is upside down (up has no
-// component along the field's +z, i.e. against gravity) or up makes less than the minimum dig angle with the
-// horizontal plane (setShovelMinimumDigAngleToHorizontalPlane, default pi/10) nothing is cut. Reading: the
-// manual's angle guards against a shovel whose forward points (nearly) straight down, where the cut is a crack
-// no particle fits in; up's angle to the horizontal plane is exactly forward's angle away from straight down
-// (forward's elevation is up's complement), so a level blade (forward horizontal, up vertical) digs best.
-// Footprint: the vertices inside the shovel geometry's world bounding box projected on the field. Each footprint
-// vertex whose height lies above the cutting plane - and above the box's lowest point: the shovel never cuts
-// deeper than it reaches - is lowered to it; the volume (vertex area x dz) moves heightField -> pending at that
-// vertex, and c rises by the compression rule above (a deformable vertex gets harder as it is dug deeper).
-// Locked border vertices are never cut.
-//
-// Particles (25.1.2.7-25.1.2.9). Pending volume becomes particles on a face-centred cubic lattice fixed in the
-// field's frame (anchored at vertex (0, 0), z = 0), nearest neighbours at d = 2r - r(sqrt2 - 1) = r(3 - sqrt2),
-// i.e. they overlap by exactly the manual's adhesive overlap r(sqrt2 - 1); the cube side is a = sqrt2 d and each
-// site stands for a^3 / 4 of space. At the default radius r = s / (2(3 sqrt2 - 2)) (s the smaller cell size)
-// the cube is half a cell: the lattice is at twice the height-field resolution. Every particle carries exactly
-// V = a^3 / 4 of soil (getParticleVolume()) taken from the pending volume of the vertex whose cell column holds
-// its site; volume that does not yet fill a particle stays pending at its vertex. A site is used when it lies
-// over the digging shovel's footprint (its bounding box seen from above), at least r above the shovel plane (the cutting plane moved up by
-// the blade thickness, |up|), at least r above the vertex's height, and no terrain particle is closer than d.
-// The lowest free sites (nearest the shovel plane) fill first. Pending volume outside a digging shovel's
-// footprint stays pending. The particle's material is a new material with the vertex material's surface
-// parameters and a density chosen so that its mass is exactly the bulk density (the vertex material's density)
-// x V; a contact material of it with itself gives particle-particle contacts the vertex material's parameters
-// and the adhesion (the index's particleAdhesion, rest overlap r(sqrt2 - 1); with particle adhesion 0 a
-// negligible 1e-9 N, since the contact law applies the rest overlap only to adhesive contacts); its carried volume is also in
-// the particles' custom buffer ParticleVolumeBuffer. Its velocity is the shovel's at the site.
-//
-// Merging. A terrain particle slower than the merge velocity (setMergeVelocity, default 0.1 m/s), over the
-// field, resting near it (its bottom within one diameter of the surface under it) and outside every shovel's
-// non-merge zone (the shovel's bounding box grown by one diameter) returns its volume to the three vertices of
-// the triangle under it by the barycentric weights (locked border vertices excluded, the weights renormalised;
-// a vertex rises by its share / its area, c falls by the compression rule, not below 0), and is destroyed:
-// particles -> heightField. A terrain particle the user destroys moves its volume particles -> removed.
-// Not in this part: external materials, the particle Young's multiplier, the ground cutting force, the DIRECT
-// particle friction solve type, the bucket fill and digging force read-outs.
-//
-// ---------------------------------------------------------------------------------------------------------------
 // Dynamic height field: avalanches and the angle of repose (manual 25.1.2.15, 25.1.2.19, 25.1.2.20)
 // ---------------------------------------------------------------------------------------------------------------
 // setEnableDynamicHeightField(true) turns avalanches on (off by default). Deformer contacts (geometries with the
@@ -207,6 +156,57 @@
 // Cost. Armed vertices live in a sparse list (each with its steps left); a step's pass visits them and their 8
 // neighbours, nothing else - no pass over the grid unless avalancheAll is called. Height edits are batched by
 // cluster as for compression, so only the touched tiles' bounds are updated.
+//
+// ---------------------------------------------------------------------------------------------------------------
+// Digging (manual 25.1.1.2, 25.1.2.6-25.1.2.9, 25.1.2.12; implemented here: shovels, the cut, particles, merging)
+// ---------------------------------------------------------------------------------------------------------------
+// Shovels. Any geometry in the simulation (on a body or static) with both Vec3 properties ShovelUpProperty and
+// ShovelForwardProperty (getPropertyContainer().addPropertyVec3) is a shovel; several may dig at once. Both
+// vectors are in the geometry's local frame: forward's length is the distance from the geometry's origin to the
+// cutting edge (the tip, origin + forward), up's length is the blade thickness; up must be orthogonal to forward
+// and point "up in the air" when the shovel rests on the ground. There is no setter to throw from, so a bad pair
+// (a zero or non-finite vector, |cos(up, forward)| > 1e-6, or a property of another type) is reported when the
+// terrain first sees the geometry - one Logger error naming the geometry and the problem - and the geometry is
+// not a shovel (isGeometryShovel is false, nothing is dug); fix the properties and it digs from the next step.
+//
+// The cut (a pre-collide step listener, before the step's contacts are found). Per shovel, in the height field's
+// frame: the cutting plane passes through the tip with normal up. Where the shovel is upside down (up has no
+// component along the field's +z, i.e. against gravity) or up makes less than the minimum dig angle with the
+// horizontal plane (setShovelMinimumDigAngleToHorizontalPlane, default pi/10) nothing is cut. Reading: the
+// manual's angle guards against a shovel whose forward points (nearly) straight down, where the cut is a crack
+// no particle fits in; up's angle to the horizontal plane is exactly forward's angle away from straight down
+// (forward's elevation is up's complement), so a level blade (forward horizontal, up vertical) digs best.
+// Footprint: the vertices inside the shovel geometry's world bounding box projected on the field. Each footprint
+// vertex whose height lies above the cutting plane - and above the box's lowest point: the shovel never cuts
+// deeper than it reaches - is lowered to it; the volume (vertex area x dz) moves heightField -> pending at that
+// vertex, and c rises by the compression rule above (a deformable vertex gets harder as it is dug deeper).
+// Locked border vertices are never cut.
+//
+// Particles (25.1.2.7-25.1.2.9). Pending volume becomes particles on a face-centred cubic lattice fixed in the
+// field's frame (anchored at vertex (0, 0), z = 0), nearest neighbours at d = 2r - r(sqrt2 - 1) = r(3 - sqrt2),
+// i.e. they overlap by exactly the manual's adhesive overlap r(sqrt2 - 1); the cube side is a = sqrt2 d and each
+// site stands for a^3 / 4 of space. At the default radius r = s / (2(3 sqrt2 - 2)) (s the smaller cell size)
+// the cube is half a cell: the lattice is at twice the height-field resolution. Every particle carries exactly
+// V = a^3 / 4 of soil (getParticleVolume()) taken from the pending volume of the vertex whose cell column holds
+// its site; volume that does not yet fill a particle stays pending at its vertex. A site is used when it lies
+// over the digging shovel's footprint (its bounding box seen from above), at least r above the shovel plane (the cutting plane moved up by
+// the blade thickness, |up|), at least r above the vertex's height, and no terrain particle is closer than d.
+// The lowest free sites (nearest the shovel plane) fill first. Pending volume outside a digging shovel's
+// footprint stays pending. The particle's material is a new material with the vertex material's surface
+// parameters and a density chosen so that its mass is exactly the bulk density (the vertex material's density)
+// x V; a contact material of it with itself gives particle-particle contacts the vertex material's parameters
+// and the adhesion (the index's particleAdhesion, rest overlap r(sqrt2 - 1); with particle adhesion 0 a
+// negligible 1e-9 N, since the contact law applies the rest overlap only to adhesive contacts); its carried volume is also in
+// the particles' custom buffer ParticleVolumeBuffer. Its velocity is the shovel's at the site.
+//
+// Merging. A terrain particle slower than the merge velocity (setMergeVelocity, default 0.1 m/s), over the
+// field, resting near it (its bottom within one diameter of the surface under it) and outside every shovel's
+// non-merge zone (the shovel's bounding box grown by one diameter) returns its volume to the three vertices of
+// the triangle under it by the barycentric weights (locked border vertices excluded, the weights renormalised;
+// a vertex rises by its share / its area, c falls by the compression rule, not below 0), and is destroyed:
+// particles -> heightField. A terrain particle the user destroys moves its volume particles -> removed.
+// Not in this part: external materials, the particle Young's multiplier, the ground cutting force, the DIRECT
+// particle friction solve type, the bucket fill and digging force read-outs.
 #pragma once
 
 #include <algorithm>
@@ -237,15 +237,6 @@ struct TerrainVolumeLedger {
   Real total() const { return heightField + compressed + particles + pending + lostAtBorder + removed; }
 };
 
-/// What digging did in the last step (see the file comment).
-struct TerrainDigStats {
-  size_t particlesCreated = 0;  ///< particles made from pending volume
-  size_t particlesMerged = 0;   ///< particles merged back into the height field (and destroyed)
-  size_t particlesRemoved = 0;  ///< terrain particles found destroyed by someone else (volume booked removed)
-  Real volumeDug = 0;           ///< m^3 cut out of the height field (heightField -> pending)
-  Real volumeMerged = 0;        ///< m^3 merged back (particles -> heightField)
-};
-
 /// What avalanches did: in the last step's pass (Terrain::getLastStepAvalancheStats) or in one avalancheAll call.
 struct TerrainAvalancheStats {
   size_t passes = 0;       ///< passes over the armed (or work) list
@@ -254,6 +245,15 @@ struct TerrainAvalancheStats {
   Real volumeMoved = 0;    ///< m^3 moved between vertices
   Real volumeLost = 0;     ///< m^3 lost over locked borders (heightField -> lostAtBorder)
   bool converged = false;  ///< avalancheAll: the last pass moved nothing (every pair within repose)
+};
+
+/// What digging did in the last step (see the file comment).
+struct TerrainDigStats {
+  size_t particlesCreated = 0;  ///< particles made from pending volume
+  size_t particlesMerged = 0;   ///< particles merged back into the height field (and destroyed)
+  size_t particlesRemoved = 0;  ///< terrain particles found destroyed by someone else (volume booked removed)
+  Real volumeDug = 0;           ///< m^3 cut out of the height field (heightField -> pending)
+  Real volumeMerged = 0;        ///< m^3 merged back (particles -> heightField)
 };
 
 class Terrain;
@@ -325,38 +325,6 @@ class Terrain : public Model {
   void setLoadAveragingTime(Real seconds);
   Real getLoadAveragingTime() const { return loadAveragingTime_; }
 
-  // --- digging (file comment) ---------------------------------------------------------------------------------
-  static constexpr const char* ShovelUpProperty = "ShovelUpProperty";
-  static constexpr const char* ShovelForwardProperty = "ShovelForwardProperty";
-  /// Name of the GranularBodySystem custom buffer holding each terrain particle's carried soil volume, m^3.
-  static constexpr const char* ParticleVolumeBuffer = "TerrainParticleVolume";
-  /// True when the geometry carries both shovel properties as valid Vec3 (nonzero, finite, orthogonal).
-  bool isGeometryShovel(const Geometry& geometry) const;
-  bool isGeometryShovel(const GeometryRef& geometry) const { return geometry && isGeometryShovel(*geometry); }
-  /// Empty when (up, forward) is a valid shovel pair, otherwise why not (the text of the logged error).
-  static std::string checkShovelVectors(const Vec3& up, const Vec3& forward);
-  /// rad, in [0, pi/2]; otherwise std::invalid_argument, unchanged.
-  void setShovelMinimumDigAngleToHorizontalPlane(Real angle);
-  Real getShovelMinimumDigAngleToHorizontalPlane() const { return minDigAngle_; }
-  /// m/s, finite and >= 0; otherwise std::invalid_argument, unchanged. 0 turns merging off.
-  void setMergeVelocity(Real velocity);
-  Real getMergeVelocity() const { return mergeVelocity_; }
-  TerrainParticleAttributes& getParticleAttributes() { return particleAttributes_; }
-  const TerrainParticleAttributes& getParticleAttributes() const { return particleAttributes_; }
-  /// The largest particle radius accepted: the smaller cell size.
-  Real getMaximumParticleRadius() const { return std::min(dx_, dy_); }
-  /// Soil volume each particle carries at the current radius, (sqrt2 r (3 - sqrt2))^3 / 4, m^3.
-  Real getParticleVolume() const;
-  /// Nearest-neighbour distance of the particle lattice, r (3 - sqrt2).
-  Real getParticleLatticeDistance() const;
-  /// Pending volume at vertex (x, y), m^3.
-  Real getPendingVolume(size_t x, size_t y) const { return pending_[y * nx_ + x]; }
-  /// Ids (GranularBodySystem) of the live particles this terrain made.
-  std::vector<size_t> getParticleIds() const;
-  /// Soil volume carried by a terrain particle (0 for any other id).
-  Real getParticleCarriedVolume(size_t id) const;
-  const TerrainDigStats& getLastStepDigStats() const { return digStats_; }
-
   // --- dynamic height field: avalanches and the angle of repose (file comment) ------------------------------------
   /// Turns the dynamic height field on or off (default off). On: armed vertices avalanche every step. Deformer
   /// contacts (DynamicHeightFieldDeformer) are not built yet. Turning it off disarms every vertex.
@@ -394,6 +362,38 @@ class Terrain : public Model {
   const TerrainAvalancheStats& getLastStepAvalancheStats() const { return avalancheStats_; }
   /// Wall-clock time of the last step's avalanche pass, s (part of getLastStepTime()).
   double getLastStepAvalancheTime() const { return lastAvalancheTime_; }
+
+  // --- digging (file comment) ---------------------------------------------------------------------------------
+  static constexpr const char* ShovelUpProperty = "ShovelUpProperty";
+  static constexpr const char* ShovelForwardProperty = "ShovelForwardProperty";
+  /// Name of the GranularBodySystem custom buffer holding each terrain particle's carried soil volume, m^3.
+  static constexpr const char* ParticleVolumeBuffer = "TerrainParticleVolume";
+  /// True when the geometry carries both shovel properties as valid Vec3 (nonzero, finite, orthogonal).
+  bool isGeometryShovel(const Geometry& geometry) const;
+  bool isGeometryShovel(const GeometryRef& geometry) const { return geometry && isGeometryShovel(*geometry); }
+  /// Empty when (up, forward) is a valid shovel pair, otherwise why not (the text of the logged error).
+  static std::string checkShovelVectors(const Vec3& up, const Vec3& forward);
+  /// rad, in [0, pi/2]; otherwise std::invalid_argument, unchanged.
+  void setShovelMinimumDigAngleToHorizontalPlane(Real angle);
+  Real getShovelMinimumDigAngleToHorizontalPlane() const { return minDigAngle_; }
+  /// m/s, finite and >= 0; otherwise std::invalid_argument, unchanged. 0 turns merging off.
+  void setMergeVelocity(Real velocity);
+  Real getMergeVelocity() const { return mergeVelocity_; }
+  TerrainParticleAttributes& getParticleAttributes() { return particleAttributes_; }
+  const TerrainParticleAttributes& getParticleAttributes() const { return particleAttributes_; }
+  /// The largest particle radius accepted: the smaller cell size.
+  Real getMaximumParticleRadius() const { return std::min(dx_, dy_); }
+  /// Soil volume each particle carries at the current radius, (sqrt2 r (3 - sqrt2))^3 / 4, m^3.
+  Real getParticleVolume() const;
+  /// Nearest-neighbour distance of the particle lattice, r (3 - sqrt2).
+  Real getParticleLatticeDistance() const;
+  /// Pending volume at vertex (x, y), m^3.
+  Real getPendingVolume(size_t x, size_t y) const { return pending_[y * nx_ + x]; }
+  /// Ids (GranularBodySystem) of the live particles this terrain made.
+  std::vector<size_t> getParticleIds() const;
+  /// Soil volume carried by a terrain particle (0 for any other id).
+  Real getParticleCarriedVolume(size_t id) const;
+  const TerrainDigStats& getLastStepDigStats() const { return digStats_; }
 
   /// Vertices loaded by contacts in the last step, and how many of them yielded.
   size_t getNumLoadedVertices() const { return numLoaded_; }
@@ -448,20 +448,6 @@ class Terrain : public Model {
   size_t numLoaded_ = 0, numYielded_ = 0;
   double lastContactTime_ = 0, lastPostTime_ = 0;
   double contactTimeAccum_ = 0;
-  // Digging.
-  Real minDigAngle_ = 3.14159265358979323846 / 10;
-  Real mergeVelocity_ = 0.1;
-  TerrainParticleAttributes particleAttributes_{*this};
-  std::vector<Real> pending_;                              ///< per vertex, m^3
-  std::vector<std::pair<size_t, Real>> particles_;        ///< live terrain particles: id, carried volume
-  std::vector<const Geometry*> reportedBadShovels_;       ///< logged once each
-  struct ParticleMaterialCache {
-    const Material* source = nullptr;
-    Real radius = 0, adhesion = 0, density = 0;
-    MaterialRef material;
-  };
-  std::vector<ParticleMaterialCache> particleMaterials_;
-  TerrainDigStats digStats_;
   // Avalanches (terrain_avalanche.cpp).
   /// Arms the three vertices of a merged particle (and the extent around them); nothing while disabled.
   void armAvalancheAt(const size_t (&v)[3]);
@@ -479,12 +465,26 @@ class Terrain : public Model {
   int avalancheExtent_ = defaultAvalancheVertexDistanceExtent;
   Real wetness_ = 0;
   std::vector<int> life_;            ///< per vertex: avalanche passes left (0: not armed)
-  std::vector<uint8_t> inList_;      ///< per vertex: listed in armed_ (or in avalancheAll's work list)
+  std::vector<uint8_t> inList_;      ///< per vertex: 1 listed in armed_, 2 visited in the running pass
   std::vector<size_t> armed_;        ///< the armed vertices (sparse)
   TerrainAvalancheStats avalancheStats_;
   double lastAvalancheTime_ = 0;
   class EditBatch;
   EditBatch* editBatch_ = nullptr;   ///< the open batch of height edits while avalanches run
+  // Digging.
+  Real minDigAngle_ = 3.14159265358979323846 / 10;
+  Real mergeVelocity_ = 0.1;
+  TerrainParticleAttributes particleAttributes_{*this};
+  std::vector<Real> pending_;                              ///< per vertex, m^3
+  std::vector<std::pair<size_t, Real>> particles_;        ///< live terrain particles: id, carried volume
+  std::vector<const Geometry*> reportedBadShovels_;       ///< logged once each
+  struct ParticleMaterialCache {
+    const Material* source = nullptr;
+    Real radius = 0, adhesion = 0, density = 0;
+    MaterialRef material;
+  };
+  std::vector<ParticleMaterialCache> particleMaterials_;
+  TerrainDigStats digStats_;
 };
 using TerrainRef = std::shared_ptr<Terrain>;
 
