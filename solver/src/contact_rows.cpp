@@ -10,6 +10,10 @@
 
 namespace scree::detail {
 
+namespace {
+constexpr uint32_t kMaxBlockPoints = 16;  ///< largest manifold solved as a block (pgs.cpp kMaxNormalBlock)
+}  // namespace
+
 void buildContactRows(SimulationState& s) {
   const Real h = s.h;
   const Solver& solver = s.solver;
@@ -61,6 +65,71 @@ void buildContactRows(SimulationState& s) {
       if (rollMu > 0) nFriction += 2;
     }
     if (nActive == 0) continue;
+    // Manifold treatment (contact_rows.h, DESIGN): the normal block needs one common normal; manifold friction
+    // also needs one friction law for all points.
+    auto muOf = [&mat](const ContactPoint& p) {
+      return p.frictionCoefficient >= 0 ? p.frictionCoefficient : mat.getFrictionCoefficient();
+    };
+    const ContactPoint* first = nullptr;
+    const bool useBlock = solver.getUseManifoldNormalBlock(), useManifoldFriction = solver.getUseManifoldFriction();
+    bool block = (useBlock || useManifoldFriction) && nActive >= 2 && nActive <= kMaxBlockPoints &&
+                 solveType == FrictionModel::ITERATIVE;
+    bool manifoldFriction = useManifoldFriction && rollMu == 0 && ftype != FrictionModel::BOX;
+    Vec3 centre = zero;
+    for (const ContactPoint& p : pts) {
+      if (!p.enabled) continue;
+      if (!first) first = &p;
+      centre += p.point;
+      block = block && p.normal.dot(first->normal) > 1 - 1e-9;
+      manifoldFriction = manifoldFriction && muOf(p) > 0 && muOf(p) == muOf(*first) &&
+                         p.frictionDirection == zero && p.surfaceVelocity == first->surfaceVelocity;
+    }
+    manifoldFriction = manifoldFriction && block;
+    // The points' offsets from the centre in the tangent plane, along the principal axes of their spread, scaled
+    // so that sum(u^2) = sum(v^2) = nActive (a degenerate axis -- collinear or coincident points -- stays 0).
+    Real blockU[kMaxBlockPoints] = {}, blockV[kMaxBlockPoints] = {};
+    Vec3 arm[kMaxBlockPoints];
+    Vec3 mt1 = zero, mt2 = zero;
+    Real rEff = 0, sumR2 = 0;
+    if (block) {
+      const Vec3 n0 = first->normal;
+      centre /= Real(nActive);
+      orthonormalBasis(n0, mt1, mt2);
+      Real a = 0, b = 0, cc = 0;
+      uint32_t k = 0;
+      for (const ContactPoint& p : pts) {
+        if (!p.enabled) continue;
+        const Vec3 d = p.point - centre;
+        arm[k] = d - n0.dot(d) * n0;
+        const Real x = arm[k].dot(mt1), y = arm[k].dot(mt2);
+        a += x * x;
+        b += x * y;
+        cc += y * y;
+        rEff += arm[k].norm();
+        sumR2 += arm[k].squaredNorm();
+        ++k;
+      }
+      rEff /= Real(nActive);
+      const Real theta = 0.5 * std::atan2(2 * b, a - cc);
+      const Vec3 e1 = std::cos(theta) * mt1 + std::sin(theta) * mt2, e2 = n0.cross(e1);
+      Real su = 0, sv = 0;
+      for (uint32_t i = 0; i < nActive; ++i) {
+        blockU[i] = arm[i].dot(e1);
+        blockV[i] = arm[i].dot(e2);
+        su += blockU[i] * blockU[i];
+        sv += blockV[i] * blockV[i];
+      }
+      const Real spread = a + cc;
+      const Real scaleU = su > 1e-10 * spread && spread > 0 ? std::sqrt(Real(nActive) / su) : 0.0;
+      const Real scaleV = sv > 1e-10 * spread && spread > 0 ? std::sqrt(Real(nActive) / sv) : 0.0;
+      for (uint32_t i = 0; i < nActive; ++i) {
+        blockU[i] *= scaleU;
+        blockV[i] *= scaleV;
+      }
+      // Friction at the centre needs a lever for the twist row: points spread around the centre.
+      manifoldFriction = manifoldFriction && rEff > 0 && sumR2 > 0;
+    }
+    if (manifoldFriction) nFriction = 3;
     ++numSolvedContacts;
     const int32_t base = int32_t(s.rows.size());
     int32_t nextFriction = base;
@@ -72,10 +141,15 @@ void buildContactRows(SimulationState& s) {
     const Real weightImpulse =
         ((dynA && dynB) ? std::min(massA, massB) : std::max(massA, massB)) * s.gravity.norm() * h / Real(nActive);
 
+    const int32_t firstNormal = nextNormal;
+    uint32_t activeIndex = 0;
+    Vec3 warmFriction = zero;  // manifold friction: sum of the points' cached friction impulses
+    Real warmTwist = 0;        // and their moment about the centre along the normal
     for (uint32_t pi = 0; pi < pts.size(); ++pi) {
       ContactPoint& p = pts[pi];
       if (!p.enabled) continue;
       ++numPoints;
+      const uint32_t ak = activeIndex++;
       const Vec3& n = p.normal;
       const Vec3 ra = p.point - xa, rb = p.point - xb;
       const WarmStartCache::Entry* ce = warm ? s.warmStart.find(pair, p.featureId, p.point) : nullptr;
@@ -103,6 +177,25 @@ void buildContactRows(SimulationState& s) {
       r.lo = nr.lo;
       r.hi = 1e300;
       r.lambda = ce ? std::max(ce->normal, r.lo) : 0.0;
+      if (block && useBlock) {
+        r.blockBegin = firstNormal;
+        r.blockCount = int32_t(nActive);
+        r.blockU = blockU[ak];
+        r.blockV = blockV[ak];
+      }
+      if (manifoldFriction) {
+        if (ce) {
+          warmFriction += ce->friction;
+          warmTwist += first->normal.dot(arm[ak].cross(ce->friction));
+        }
+        PointRows pr{ci, pi, nextNormal, base, mt1, mt2, nr.impactSpeed};
+        pr.twist = base + 2;
+        pr.share = 1.0 / Real(nActive);
+        pr.twistArm = first->normal.cross(arm[ak]) / sumR2;
+        s.pointRows.push_back(pr);
+        ++nextNormal;
+        continue;
+      }
 
       // --- friction rows ---
       const Real mu = p.frictionCoefficient >= 0 ? p.frictionCoefficient : mat.getFrictionCoefficient();
@@ -169,6 +262,40 @@ void buildContactRows(SimulationState& s) {
       }
       s.pointRows.push_back({ci, pi, nextNormal, t1Index, t1, t2, nr.impactSpeed});
       ++nextNormal;
+    }
+    if (manifoldFriction) {
+      // [t1, t2, twist] at the manifold's centre, bounded by the sum of its normal impulses (contact_rows.h).
+      const Real mu = muOf(*first);
+      const Real eVisc = spookVelocityRegularisation(h, mat.getSurfaceViscosity());
+      for (int k = 0; k < 2; ++k) {
+        const Vec3& t = k == 0 ? mt1 : mt2;
+        ConstraintRow& f = s.rows[base + k];
+        f = pointRow(ia, ib, centre - xa, centre - xb, t);
+        f.rhs = first->surfaceVelocity.dot(t);
+        f.e = eVisc / Real(nActive);  // the points' viscous compliances act in parallel
+        f.mu = mu;
+        f.solveType = solveType;
+        f.friction = true;
+        f.lambda = warmFriction.dot(t);
+        f.normalRow = firstNormal;
+        f.normalCount = int32_t(nActive);
+        if (k == 0 && ftype == FrictionModel::ITERATIVE_PROJECTED_CONE) f.pairedRow = base + 1;
+      }
+      // Twist: torque about the normal. Point i slips at w r_i and its viscous row carries w r_i / e, a torque
+      // w r_i^2 / e, so the points together give e_twist = e / sum(r_i^2) (rad/s per N m s).
+      ConstraintRow& tw = s.rows[base + 2];
+      tw = ConstraintRow{};
+      tw.bodyA = ia;
+      tw.bodyB = ib;
+      tw.jAngA = first->normal;
+      tw.jAngB = -first->normal;
+      tw.e = eVisc / sumR2;
+      tw.mu = std::isinf(mu) ? mu : mu * rEff;
+      tw.solveType = solveType;
+      tw.friction = true;
+      tw.lambda = warmTwist;
+      tw.normalRow = firstNormal;
+      tw.normalCount = int32_t(nActive);
     }
   }
   s.nonIterativeRows = nonIterative;

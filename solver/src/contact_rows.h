@@ -6,6 +6,15 @@
 // normal row (contact_law.h), two friction rows when mu > 0 (the friction model decides box, scaled box or
 // projected cone) and two rolling-resistance rows when the material has a rolling coefficient.
 //
+// Manifolds (DESIGN, issue 18; docs/solver-internals.md "Resting stacks"): a contact of 2..16 points with one
+// normal and ITERATIVE solve type has its normal rows solved as one block (ConstraintRow::blockCount, pgs.cpp).
+// When its points also share mu (> 0), surface velocity and no primary direction, have no rolling resistance
+// and the friction model is a scaled box or projected cone, its friction is not per point but one tangent pair
+// at the manifold's centre bounded by mu * sum(lambda_n) and one twist row about the normal bounded by
+// mu * r_eff * sum(lambda_n) (r_eff the points' mean distance from the centre): [t1, t2, twist][normals].
+// Per-point friction rows solved in Gauss-Seidel order push a symmetric manifold sideways (each corner's row sees
+// the previous corners' impulses); the centre pair acts on the manifold as a whole.
+//
 // Warm start: the impulses of last step's points, keyed by (geometry pair, narrowphase feature id), start
 // this step's rows; the cache also carries the approach speed of a speculative stop (the impact memory of the
 // contact law).
@@ -25,6 +34,13 @@ struct PointRows {
   int32_t normal, t1;  // t1 = -1: no friction rows; t2 = t1 + 1
   Vec3 tangent1, tangent2;
   Real impactSpeed;
+  // Manifold friction (twist >= 0): t1, t2 are the manifold's rows at its centre, shared by its points. The
+  // point reports the share  F / n + lambda_twist * twistArm  of the manifold's friction impulse F, where
+  // twistArm = normal x (point - centre) / sum |point - centre|^2: the shares sum to F and their moment about the
+  // centre is the twist impulse, so the warm start rebuilds both from the points' cached friction.
+  int32_t twist = -1;
+  Real share = 1;
+  Vec3 twistArm = Vec3::Zero();
 };
 
 /// The row range and solver bodies of one solved contact or constraint (the couplings of the shock order).

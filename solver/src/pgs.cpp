@@ -10,6 +10,7 @@ namespace scree::detail {
 
 namespace {
 const SolverBodyState kStatic{};
+constexpr int kMaxNormalBlock = 16;  ///< most normal rows one block holds (contact_rows.cpp builds no larger)
 
 inline Real rowVelocity(const ConstraintRow& r, const std::vector<SolverBodyState>& b) {
   Real jv = 0;
@@ -29,7 +30,188 @@ inline void applyImpulse(const ConstraintRow& r, Real d, std::vector<SolverBodyS
   }
 }
 
+/// The bound's normal impulse of a friction row: its normal row, or the sum over a manifold's normal rows.
+inline Real boundingNormal(const std::vector<ConstraintRow>& rows, const ConstraintRow& r) {
+  if (r.normalCount == 1) return rows[r.normalRow].lambda;
+  Real sum = 0;
+  for (int32_t k = 0; k < r.normalCount; ++k) sum += std::max<Real>(rows[r.normalRow + k].lambda, 0);
+  return sum;
+}
+
 }  // namespace
+
+// DESIGN (issue 18, docs/solver-internals.md "Resting stacks"): the normal rows of a planar manifold (a box face
+// on a box face) are solved as one block, so that a symmetric manifold gets symmetric impulses. Gauss-Seidel
+// over the four corners of a resting box leaves the first-visited corner with more impulse than the last, a
+// torque that tilts the box a little every step (1.7e-4 rad/s after one step of the issue-18 tower); on a stack
+// the tilt turns into sideways motion and towers topple by themselves.
+//
+// The block is not solved in the points' own coordinates: four coplanar points with one normal make a rank-3
+// block (the (+,-,+,-) mode moves nothing), and (K + E)^-1 gives that mode residual / e, which with SPOOK's small
+// e exploded pyramid20. The rows J_i = J_c + u_i G_u + v_i G_v are combinations of three rows (a push at the
+// manifold's centre and tilts about its two principal axes), so the block is solved on those: impulses
+// dlambda = D^T dmu with D = [1; u; v] (3 x n), and dmu from the Galerkin system D (K + E) D^T dmu = D r, r the
+// rows' residuals. That is the exact block solution with the null mode left out; the null mode applies no
+// impulse to any body, so leaving it out changes no motion. The system is 3 x 3 and SPD whatever n is.
+//
+// The update is kept only when every row stays within its bounds (a resting or evenly impacting manifold);
+// otherwise -- a box tipping onto an edge, a speculative manifold still apart -- the rows are solved one by one
+// as before, which handles the clamping.
+// The block's update when the unclamped one leaves a row below its bound: rows are released (held at their
+// bound) one at a time, the most negative first, and the rows still active (at most 3: then the points' own
+// block K_AA + E_A is regular) are solved exactly with the released rows' change held. dl holds the unclamped
+// update on entry. Returns false when more than 3 rows stay active (the caller then solves row by row).
+static bool solveClampedBlock(ConstraintRow* R, int n, const Real* resid, Real* dl, bool useA, bool useB,
+                              std::vector<SolverBodyState>& bodies, Real& change) {
+  bool active[kMaxNormalBlock];
+  for (int i = 0; i < n; ++i) active[i] = true;
+  auto K = [&](int i, int j) {
+    Real k = i == j ? R[i].e : 0.0;
+    if (useA) k += R[i].jLinA.dot(R[j].mJLinA) + R[i].jAngA.dot(R[j].mJAngA);
+    if (useB) k += R[i].jLinB.dot(R[j].mJLinB) + R[i].jAngB.dot(R[j].mJAngB);
+    return k;
+  };
+  for (int round = 0; round < n; ++round) {
+    // Release the most violating active row.
+    int worst = -1;
+    Real worstV = 0;
+    for (int i = 0; i < n; ++i)
+      if (active[i]) {
+        const Real v = R[i].lo - (R[i].lambda + dl[i]);
+        if (v > worstV) { worstV = v; worst = i; }
+      }
+    if (worst < 0) break;
+    active[worst] = false;
+    int idx[kMaxNormalBlock], m = 0;
+    for (int i = 0; i < n; ++i) {
+      if (active[i]) idx[m++] = i;
+      else dl[i] = R[i].lo - R[i].lambda;
+    }
+    if (m > 3) return false;
+    if (m > 0) {
+      Eigen::Matrix<Real, 3, 3> A = Eigen::Matrix<Real, 3, 3>::Identity();
+      Eigen::Matrix<Real, 3, 1> rhs = Eigen::Matrix<Real, 3, 1>::Zero();
+      for (int a = 0; a < m; ++a) {
+        rhs[a] = resid[idx[a]];
+        for (int i = 0; i < n; ++i)
+          if (!active[i] && dl[i] != 0) rhs[a] -= K(idx[a], i) * dl[i];
+        for (int c = 0; c < m; ++c) A(a, c) = K(idx[a], idx[c]);
+      }
+      const Eigen::LDLT<Eigen::Matrix<Real, 3, 3>> ldlt(A);
+      if (ldlt.info() != Eigen::Success) return false;
+      const Eigen::Matrix<Real, 3, 1> x = ldlt.solve(rhs);
+      if (!x.allFinite()) return false;
+      for (int a = 0; a < m; ++a) dl[idx[a]] = x[a];
+    }
+  }
+  for (int i = 0; i < n; ++i)
+    if (R[i].lambda + dl[i] < R[i].lo - 1e-12 * std::abs(R[i].lambda) || R[i].lambda + dl[i] > R[i].hi) return false;
+  Real maxD = 0;
+  for (int i = 0; i < n; ++i) {
+    const Real nl = std::max(R[i].lambda + dl[i], R[i].lo);
+    const Real d = nl - R[i].lambda;
+    R[i].lambda = nl;
+    maxD = std::max(maxD, std::abs(d));
+    if (d == 0) continue;
+    if (useA) {
+      bodies[R[i].bodyA].v += R[i].mJLinA * d;
+      bodies[R[i].bodyA].w += R[i].mJAngA * d;
+    }
+    if (useB) {
+      bodies[R[i].bodyB].v += R[i].mJLinB * d;
+      bodies[R[i].bodyB].w += R[i].mJAngB * d;
+    }
+  }
+  change = maxD;
+  return true;
+}
+
+static bool solveNormalBlock(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, size_t begin,
+                             int frozen, Real& change) {
+  ConstraintRow* R = rows.data() + begin;
+  const int n = R[0].blockCount;
+  const bool useA = frozen != 0 && R[0].bodyA >= 0, useB = frozen != 1 && R[0].bodyB >= 0;
+  Real su = 0, sv = 0;
+  for (int i = 0; i < n; ++i) {
+    su += R[i].blockU * R[i].blockU;
+    sv += R[i].blockV * R[i].blockV;
+  }
+  const bool axisU = su > 0, axisV = sv > 0;
+  auto D = [&](int a, int i) -> Real { return a == 0 ? 1.0 : a == 1 ? R[i].blockU : R[i].blockV; };
+  // W_a = M^-1 J^T D_a^T: the velocity change of a unit dmu_a, per body.
+  Vec3 wLinA[3], wAngA[3], wLinB[3], wAngB[3];
+  for (int a = 0; a < 3; ++a) {
+    wLinA[a] = wAngA[a] = wLinB[a] = wAngB[a] = Vec3::Zero();
+    for (int i = 0; i < n; ++i) {
+      const Real d = D(a, i);
+      if (d == 0) continue;
+      wLinA[a] += d * R[i].mJLinA;
+      wAngA[a] += d * R[i].mJAngA;
+      wLinB[a] += d * R[i].mJLinB;
+      wAngB[a] += d * R[i].mJAngB;
+    }
+  }
+  Eigen::Matrix<Real, 3, 3> S = Eigen::Matrix<Real, 3, 3>::Zero();
+  Eigen::Matrix<Real, 3, 1> b = Eigen::Matrix<Real, 3, 1>::Zero();
+  Real resid[kMaxNormalBlock];
+  for (int i = 0; i < n; ++i) {
+    const ConstraintRow& r = R[i];
+    Real jv = 0;
+    if (r.bodyA >= 0) jv += r.jLinA.dot(bodies[r.bodyA].v) + r.jAngA.dot(bodies[r.bodyA].w);
+    if (r.bodyB >= 0) jv += r.jLinB.dot(bodies[r.bodyB].v) + r.jAngB.dot(bodies[r.bodyB].w);
+    const Real res = r.rhs - jv - r.e * r.lambda;
+    resid[i] = res;
+    Real jw[3];
+    for (int c = 0; c < 3; ++c) {
+      jw[c] = 0;
+      if (useA) jw[c] += r.jLinA.dot(wLinA[c]) + r.jAngA.dot(wAngA[c]);
+      if (useB) jw[c] += r.jLinB.dot(wLinB[c]) + r.jAngB.dot(wAngB[c]);
+    }
+    for (int a = 0; a < 3; ++a) {
+      const Real da = D(a, i);
+      b[a] += da * res;
+      for (int c = 0; c < 3; ++c) S(a, c) += da * (jw[c] + r.e * D(c, i));
+    }
+  }
+  // A degenerate axis (collinear or coincident points) carries nothing: identity row, zero right-hand side.
+  for (int a = 1; a < 3; ++a)
+    if (!(a == 1 ? axisU : axisV)) {
+      S.row(a).setZero();
+      S.col(a).setZero();
+      S(a, a) = 1;
+      b[a] = 0;
+    }
+  const Eigen::LLT<Eigen::Matrix<Real, 3, 3>> llt(S);
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::Matrix<Real, 3, 1> dmu = llt.solve(b);
+  if (!dmu.allFinite()) return false;
+  Real dl[kMaxNormalBlock];
+  for (int i = 0; i < n; ++i) {
+    dl[i] = dmu[0] + dmu[1] * R[i].blockU + dmu[2] * R[i].blockV;
+    const Real nl = R[i].lambda + dl[i];
+    if (nl < R[i].lo || nl > R[i].hi) {
+      return solveClampedBlock(R, n, resid, dl, useA, useB, bodies, change);
+    }
+  }
+  Real maxD = 0;
+  for (int i = 0; i < n; ++i) {
+    R[i].lambda += dl[i];
+    maxD = std::max(maxD, std::abs(dl[i]));
+  }
+  for (int a = 0; a < 3; ++a) {
+    if (dmu[a] == 0) continue;
+    if (useA) {
+      bodies[R[0].bodyA].v += wLinA[a] * dmu[a];
+      bodies[R[0].bodyA].w += wAngA[a] * dmu[a];
+    }
+    if (useB) {
+      bodies[R[0].bodyB].v += wLinB[a] * dmu[a];
+      bodies[R[0].bodyB].w += wAngB[a] * dmu[a];
+    }
+  }
+  change = maxD;
+  return true;
+}
 
 void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies) {
   for (ConstraintRow& r : rows) {
@@ -65,7 +247,7 @@ static Real solveUnit(std::vector<ConstraintRow>& rows, std::vector<SolverBodySt
     Real d1 = (r.rhs - rowVelocity(r, bodies) - r.e * r.lambda) * r.invDiag;
     Real d2 = (s.rhs - rowVelocity(s, bodies) - s.e * s.lambda) * s.invDiag;
     Real l1 = r.lambda + d1, l2 = s.lambda + d2;
-    const Real lim = r.normalRow >= 0 ? frictionLimit(r.mu, rows[r.normalRow].lambda) : r.hi;
+    const Real lim = r.normalRow >= 0 ? frictionLimit(r.mu, boundingNormal(rows, r)) : r.hi;
     projectOntoDisc(l1, l2, lim);
     d1 = l1 - r.lambda;
     d2 = l2 - s.lambda;
@@ -77,8 +259,8 @@ static Real solveUnit(std::vector<ConstraintRow>& rows, std::vector<SolverBodySt
   }
   Real lo = r.lo, hi = r.hi;
   if (r.normalRow >= 0) {
-    // Scaled box: bounds follow the current normal impulse.
-    const Real lim = frictionLimit(r.mu, rows[r.normalRow].lambda);
+    // Scaled box (and a manifold's twist row): bounds follow the current normal impulse.
+    const Real lim = frictionLimit(r.mu, boundingNormal(rows, r));
     lo = -lim;
     hi = lim;
   }
@@ -101,11 +283,34 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     maxDelta = 0;
     if (it % 2 == 0) {
       for (size_t i = 0; i < n; ++i) {
+        if (rows[i].blockCount > 1) {
+          // A manifold's normal block (i is its first row): one block update, else its rows one by one.
+          const size_t count = size_t(rows[i].blockCount);
+          Real d = 0;
+          if (solveNormalBlock(rows, bodies, i, -1, d)) {
+            maxDelta = std::max(maxDelta, d);
+          } else {
+            for (size_t k = i; k < i + count; ++k) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
+          }
+          i += count - 1;
+          continue;
+        }
         maxDelta = std::max(maxDelta, solveUnit(rows, bodies, i));
         if (rows[i].pairedRow == int32_t(i) + 1) ++i;
       }
     } else {
       for (size_t j = n; j-- > 0;) {
+        if (rows[j].blockCount > 1) {
+          const size_t first = size_t(rows[j].blockBegin);
+          Real d = 0;
+          if (solveNormalBlock(rows, bodies, first, -1, d)) {
+            maxDelta = std::max(maxDelta, d);
+          } else {
+            for (size_t k = j + 1; k-- > first;) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
+          }
+          j = first;
+          continue;
+        }
         if (j > 0 && rows[j - 1].pairedRow == int32_t(j)) --j;
         maxDelta = std::max(maxDelta, solveUnit(rows, bodies, j));
       }
@@ -160,19 +365,28 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
     }
     return d;
   };
-  for (const ShockRange& sr : ranges)
-  for (int sweep = 0; sweep < maxSweeps; ++sweep) {
-    Real change = 0, scale = 0;
+  auto sweepRange = [&](const ShockRange& sr, Real& change, Real& scale) {
     // Normals (rows without a normalRow link) first, then the friction rows bounded by them.
-    for (uint32_t i = sr.begin; i < sr.begin + sr.count; ++i)
-      if (rows[i].normalRow < 0 && rows[i].pairedRow < 0) {
-        change = std::max(change, std::abs(solveFrozen(rows[i], sr.frozen, rows[i].lo, rows[i].hi)));
-        scale = std::max(scale, std::abs(rows[i].lambda));
+    for (uint32_t i = sr.begin; i < sr.begin + sr.count; ++i) {
+      if (rows[i].normalRow >= 0 || rows[i].pairedRow >= 0) continue;
+      if (rows[i].blockCount > 1 && rows[i].blockBegin == int32_t(i)) {
+        // A manifold's normal block, solved as in the sweeps (solveNormalBlock) with the lower body frozen.
+        const uint32_t count = uint32_t(rows[i].blockCount);
+        Real d = 0;
+        if (solveNormalBlock(rows, bodies, i, sr.frozen, d)) {
+          change = std::max(change, d);
+          for (uint32_t k = i; k < i + count; ++k) scale = std::max(scale, std::abs(rows[k].lambda));
+          i += count - 1;
+          continue;
+        }
       }
+      change = std::max(change, std::abs(solveFrozen(rows[i], sr.frozen, rows[i].lo, rows[i].hi)));
+      scale = std::max(scale, std::abs(rows[i].lambda));
+    }
     for (uint32_t i = sr.begin; i < sr.begin + sr.count; ++i) {
       ConstraintRow& r = rows[i];
       if (r.normalRow < 0) continue;
-      const Real lim = frictionLimit(r.mu, rows[r.normalRow].lambda);
+      const Real lim = frictionLimit(r.mu, boundingNormal(rows, r));
       if (r.pairedRow == int32_t(i) + 1) {
         ConstraintRow& s = rows[i + 1];
         change = std::max(change, std::abs(solveFrozen(r, sr.frozen, -lim, lim)));
@@ -200,10 +414,15 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
         change = std::max(change, std::abs(solveFrozen(r, sr.frozen, -lim, lim)));
       }
     }
-    // Converged: the support's impulses moved by less than 1e-9 of their size (a warm-started resting stack
-    // gets here after one or two sweeps).
-    if (change <= 1e-9 * scale) break;
-  }
+  };
+  for (const ShockRange& sr : ranges)
+    for (int sweep = 0; sweep < maxSweeps; ++sweep) {
+      Real change = 0, scale = 0;
+      sweepRange(sr, change, scale);
+      // Converged: the support's impulses moved by less than 1e-9 of their size (a warm-started resting stack
+      // gets here after one or two sweeps).
+      if (change <= 1e-9 * scale) break;
+    }
 }
 
 }  // namespace scree::detail

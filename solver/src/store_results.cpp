@@ -13,6 +13,7 @@ void storeResults(SimulationState& s) {
     const Real ln = s.rows[pr.normal].lambda;
     Vec3 ft = Vec3::Zero();
     if (pr.t1 >= 0) ft = s.rows[pr.t1].lambda * pr.tangent1 + s.rows[pr.t1 + 1].lambda * pr.tangent2;
+    if (pr.twist >= 0) ft = pr.share * ft + s.rows[pr.twist].lambda * pr.twistArm;  // manifold friction's share
     p.normalImpulse = ln;
     p.frictionImpulse = ft;
     p.normalForce = ln * invH;

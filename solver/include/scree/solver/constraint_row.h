@@ -37,6 +37,18 @@ struct ConstraintRow {
   Real drift = 0;
   bool holonomic = false;
 
+  // ---- Contact manifolds (issue 18: resting stacks; built by solver/src/contact_rows.cpp, solved in pgs.cpp) ----
+  /// Friction rows: the number of consecutive normal rows from normalRow whose impulses sum into the bound.
+  /// Manifold friction (one tangent pair at the manifold's centre and one twist row) is bounded by
+  /// mu * sum(lambda_n) (twist: mu * r_eff * sum(lambda_n)); per-point friction has 1.
+  int32_t normalCount = 1;
+  /// Normal rows of a planar manifold solved as one block (PgsSolver: solveNormalBlock): every row of the block
+  /// holds the first row's index and the count (0: solved alone), and its point's coordinates along the
+  /// manifold's principal axes from its centre, scaled so that sum(u^2) = sum(v^2) = count (0 on a degenerate
+  /// axis: collinear or coincident points).
+  int32_t blockBegin = -1, blockCount = 0;
+  Real blockU = 0, blockV = 0;
+
   // Filled by the solver's prepare step.
   Vec3 mJLinA = Vec3::Zero(), mJAngA = Vec3::Zero(), mJLinB = Vec3::Zero(), mJAngB = Vec3::Zero();  ///< M^-1 J^T
   Real invDiag = 0;                      ///< 1 / (J M^-1 J^T + e)
