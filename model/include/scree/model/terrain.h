@@ -113,7 +113,15 @@
 // manual's angle guards against a shovel whose forward points (nearly) straight down, where the cut is a crack
 // no particle fits in; up's angle to the horizontal plane is exactly forward's angle away from straight down
 // (forward's elevation is up's complement), so a level blade (forward horizontal, up vertical) digs best.
-// Footprint: the vertices inside the shovel geometry's world bounding box projected on the field. Each footprint
+// Footprint: the vertices inside the shovel geometry's world bounding box projected on the field, the box reaching
+// a lead of one cell plus one particle diameter (max(dx, dy) + 2r) further on the side of the cutting edge (the
+// direction from the box's centre to the tip, seen from above). Why the lead: the uncut ground next to the cut is
+// a slope one cell wide, a rigid wall; without the lead it stands within a cell of the edge, and particles the
+// blade pushes wedge between the blade and that wall and jam, loading the blade with forces that grew with the
+// solver's iterations and with smaller time steps (a blade study gave 33, 50 and 88 N for 30 and 60 iterations
+// and half the step, docs/terrain.md); with the wall a particle diameter clear of the edge they rise instead
+// (10.3, 10.8, 14.1 N), as loosened soil in front of a real blade does. Particles are made over the box only (below):
+// the lead's volume stays pending until the box passes over it. Each footprint
 // vertex whose height lies above the cutting plane - and above the box's lowest point: the shovel never cuts
 // deeper than it reaches - is lowered to it; the volume (vertex area x dz) moves heightField -> pending at that
 // vertex, and c rises by the compression rule above (a deformable vertex gets harder as it is dug deeper).
@@ -142,8 +150,8 @@
 // the triangle under it by the barycentric weights (locked border vertices excluded, the weights renormalised;
 // a vertex rises by its share / its area, c falls by the compression rule, not below 0), and is destroyed:
 // particles -> heightField. A terrain particle the user destroys moves its volume particles -> removed.
-// Not in this part: external materials, the particle Young's multiplier, the ground cutting force, the DIRECT
-// particle friction solve type, the bucket fill and digging force read-outs.
+// Not in this part: external materials, the particle Young's multiplier, the DIRECT particle friction solve type.
+// The shovel read-outs (digging force, fill) and the ground cutting force are below (TerrainShovelStats).
 #pragma once
 
 #include <algorithm>
