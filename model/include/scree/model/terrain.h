@@ -121,7 +121,8 @@
 // solver's iterations and with smaller time steps (a blade study gave 33, 50 and 88 N for 30 and 60 iterations
 // and half the step, docs/terrain.md); with the wall a particle diameter clear of the edge they rise instead
 // (10.3, 10.8, 14.1 N), as loosened soil in front of a real blade does. Particles are made over the box only (below):
-// the lead's volume stays pending until the box passes over it. Each footprint
+// the lead's volume stays pending until the box passes over it (where a shovel stops, the trench runs a lead
+// further than the box went and that strip stays pending). Each footprint
 // vertex whose height lies above the cutting plane - and above the box's lowest point: the shovel never cuts
 // deeper than it reaches - is lowered to it; the volume (vertex area x dz) moves heightField -> pending at that
 // vertex, and c rises by the compression rule above (a deformable vertex gets harder as it is dug deeper).
