@@ -108,8 +108,8 @@ TEST_CASE("FEE digging-force study: force proportional to width, within a factor
   }
 }
 
-// The issue's bound on the depth exponent does not hold (docs/terrain.md: measured 1.3-1.7; the soil the blade has
-// already dug accumulates in front of it and adds a force linear in d). Skipped, not loosened: run it with
+// The issue's bound on the depth exponent does not hold (docs/terrain.md: measured 1.50-1.65; the soil the blade
+// has already dug accumulates in front of it and adds a force linear in d). Skipped, not loosened: run it with
 // --no-skip to see the fitted exponents.
 TEST_CASE("FEE digging-force study: fitted exponent of d is 2 +- 0.4" * doctest::skip()) {
   const Study& s = study();

@@ -33,7 +33,7 @@ struct TerrainFeeParams {
   Real width = 0.3;           ///< w, m
   Real rake = 0.7853981633974483;  ///< alpha, rad from the horizontal
   Real bladeLength = 0.4;     ///< m, along the blade from the edge up
-  Real bladeThickness = 0.01; ///< m
+  Real bladeThickness = 0.002; ///< m (thin: a blunt edge presses particles smaller than it into the floor)
   Real speed = 0.2;           ///< m/s along +x
   Real travel = 0.3;          ///< m pushed
   Real cell = 0.02;           ///< height-field cell, m

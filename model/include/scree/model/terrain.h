@@ -118,8 +118,8 @@
 // direction from the box's centre to the tip, seen from above). Why the lead: the uncut ground next to the cut is
 // a slope one cell wide, a rigid wall; without the lead it stands within a cell of the edge, and particles the
 // blade pushes wedge between the blade and that wall and jam, loading the blade with forces that grew with the
-// solver's iterations and with smaller time steps (a blade study gave 33, 50 and 88 N for 30 and 60 iterations
-// and half the step, docs/terrain.md); with the wall a particle diameter clear of the edge they rise instead
+// solver's iterations and with smaller time steps (a 1 cm blade in the FEE study gave 33, 50 and 88 N for 30 and
+// 60 iterations and half the step, docs/terrain.md); with the wall a particle diameter clear of the edge they rise instead
 // (10.3, 10.8, 14.1 N), as loosened soil in front of a real blade does. Particles are made over the box only (below):
 // the lead's volume stays pending until the box passes over it (where a shovel stops, the trench runs a lead
 // further than the box went and that strip stays pending). Each footprint
