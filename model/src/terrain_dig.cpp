@@ -188,10 +188,22 @@ void Terrain::cut(const Shovel& s) {
   const auto clampIndex = [](Real u, size_t n) -> long long {
     return std::clamp<long long>((long long)std::floor(u), -1, (long long)n);
   };
-  const long long i0 = std::max<long long>(0, clampIndex((s.loX - x0) / dx_, nx_) + 1);
-  const long long i1 = std::min<long long>((long long)nx_ - 1, clampIndex((s.hiX - x0) / dx_, nx_));
-  const long long j0 = std::max<long long>(0, clampIndex((s.loY - y0) / dy_, ny_) + 1);
-  const long long j1 = std::min<long long>((long long)ny_ - 1, clampIndex((s.hiY - y0) / dy_, ny_));
+  // The lead (terrain.h, "the cut"): the footprint reaches one cell plus one particle diameter beyond the box
+  // on the side of the cutting edge, so the rigid wall of uncut ground stands clear of the edge.
+  Real loX = s.loX, hiX = s.hiX, loY = s.loY, hiY = s.hiY;
+  {
+    const Real lead = std::max(dx_, dy_) + 2 * particleAttributes_.getParticleRadius();
+    const Real ex = s.tipL.x() - 0.5 * (s.loX + s.hiX), ey = s.tipL.y() - 0.5 * (s.loY + s.hiY);
+    const Real len = std::hypot(ex, ey);
+    if (len > 0) {
+      (ex > 0 ? hiX : loX) += lead * ex / len;
+      (ey > 0 ? hiY : loY) += lead * ey / len;
+    }
+  }
+  const long long i0 = std::max<long long>(0, clampIndex((loX - x0) / dx_, nx_) + 1);
+  const long long i1 = std::min<long long>((long long)nx_ - 1, clampIndex((hiX - x0) / dx_, nx_));
+  const long long j0 = std::max<long long>(0, clampIndex((loY - y0) / dy_, ny_) + 1);
+  const long long j1 = std::min<long long>((long long)ny_ - 1, clampIndex((hiY - y0) / dy_, ny_));
   if (i0 > i1 || j0 > j1) return;
   TerrainDataInterface& di = *data_;
   const Real M = di.maxMultiplier_, D = di.depthForMax_;

@@ -176,7 +176,16 @@
 // manual's angle guards against a shovel whose forward points (nearly) straight down, where the cut is a crack
 // no particle fits in; up's angle to the horizontal plane is exactly forward's angle away from straight down
 // (forward's elevation is up's complement), so a level blade (forward horizontal, up vertical) digs best.
-// Footprint: the vertices inside the shovel geometry's world bounding box projected on the field. Each footprint
+// Footprint: the vertices inside the shovel geometry's world bounding box projected on the field, the box reaching
+// a lead of one cell plus one particle diameter (max(dx, dy) + 2r) further on the side of the cutting edge (the
+// direction from the box's centre to the tip, seen from above). Why the lead: the uncut ground next to the cut is
+// a slope one cell wide, a rigid wall; without the lead it stands within a cell of the edge, and particles the
+// blade pushes wedge between the blade and that wall and jam, loading the blade with forces that grew with the
+// solver's iterations and with smaller time steps (a 1 cm blade in the FEE study gave 33, 50 and 88 N for 30 and
+// 60 iterations and half the step, docs/terrain.md); with the wall a particle diameter clear of the edge they rise instead
+// (10.3, 10.8, 14.1 N), as loosened soil in front of a real blade does. Particles are made over the box only (below):
+// the lead's volume stays pending until the box passes over it (where a shovel stops, the trench runs a lead
+// further than the box went and that strip stays pending). Each footprint
 // vertex whose height lies above the cutting plane - and above the box's lowest point: the shovel never cuts
 // deeper than it reaches - is lowered to it; the volume (vertex area x dz) moves heightField -> pending at that
 // vertex, and c rises by the compression rule above (a deformable vertex gets harder as it is dug deeper).
@@ -205,8 +214,8 @@
 // the triangle under it by the barycentric weights (locked border vertices excluded, the weights renormalised;
 // a vertex rises by its share / its area, c falls by the compression rule, not below 0), and is destroyed:
 // particles -> heightField. A terrain particle the user destroys moves its volume particles -> removed.
-// Not in this part: external materials, the particle Young's multiplier, the ground cutting force, the DIRECT
-// particle friction solve type, the bucket fill and digging force read-outs.
+// Not in this part: external materials, the particle Young's multiplier, the DIRECT particle friction solve type.
+// The shovel read-outs (digging force, fill) and the ground cutting force are below (TerrainShovelStats).
 #pragma once
 
 #include <algorithm>
@@ -257,6 +266,41 @@ struct TerrainDigStats {
 };
 
 class Terrain;
+
+// ---------------------------------------------------------------------------------------------------------------
+// Shovel read-outs (manual 25.1.1.2; model/src/terrain_shovel.cpp). After each step's solve the terrain's
+// post-step listener records, for every valid shovel geometry in the simulation (any geometry the digging
+// treats as a shovel, whether it touched anything or not):
+//   terrainContactForce   sum over the enabled, non-sensor contact points between the shovel geometry and the
+//                         terrain geometry of the force the solver applied on the shovel (normal + friction,
+//                         world frame, N; adhesion pulling counts with its sign).
+//   particleContactForce  the same over the particle-geometry contacts between the shovel geometry and the
+//                         live particles this terrain made (GranularBodySystem contact lists: the force on the
+//                         particle is normalForce * normal + frictionForce, the shovel feels its negative).
+//                         Particles of other origin are not counted.
+//   fill                  the terrain particles whose centre lies (a) inside the fill box: the union B of the world
+//                         bounding boxes of all geometries on the shovel's body (the shovel geometry's own box
+//                         for a static shovel; a bucket's plates together bound its inside), with its top raised
+//                         by B's larger horizontal side, and (b) on the up side of the shovel plane (the cutting
+//                         plane through the tip moved up by the blade thickness: the plane particles are created
+//                         above). fillVolume sums their carried volumes (m^3), fillParticles counts them.
+//                         Why a box: a shovel is any set of geometries; the box is defined for all of them and its
+//                         horizontal extent is the footprint the cut uses. Why raised: a flat blade's own box is
+//                         as thin as the blade, and a heap on a footprint of side s stands lower than s for any
+//                         repose angle below 63 degrees, so the raised box holds what a blade or bucket carries.
+//                         (b) keeps out what lies under or behind the blade. World z is taken as up.
+// Geometry poses are this step's final ones (after integration). A shovel that is not valid (or no longer in
+// the simulation) has no entry; getShovelStats then returns zeros with `shovel` set.
+// ---------------------------------------------------------------------------------------------------------------
+/// Per shovel, last step (see the file comment): forces on the shovel (world frame, N) and its fill.
+struct TerrainShovelStats {
+  const Geometry* shovel = nullptr;
+  Vec3 terrainContactForce = Vec3::Zero();   ///< from contacts with the terrain geometry
+  Vec3 particleContactForce = Vec3::Zero();  ///< from contacts with terrain particles
+  Real fillVolume = 0;                       ///< soil volume of the terrain particles in the shovel (m^3)
+  size_t fillParticles = 0;
+  Vec3 diggingForce() const { return terrainContactForce + particleContactForce; }
+};
 
 /// Particle attributes of a terrain (manual 25.1.2.8): the radius of particles made from now on.
 class TerrainParticleAttributes {
@@ -395,6 +439,15 @@ class Terrain : public Model {
   Real getParticleCarriedVolume(size_t id) const;
   const TerrainDigStats& getLastStepDigStats() const { return digStats_; }
 
+  // --- shovel read-outs and ground cutting force (terrain_shovel.cpp; see TerrainShovelStats) ----------------
+  /// One entry per valid shovel geometry of the last step, in the order the simulation lists them.
+  const std::vector<TerrainShovelStats>& getLastStepShovelStats() const { return shovelStats_; }
+  /// The shovel's entry of the last step; zeros (with `shovel` set) when it was not seen last step.
+  TerrainShovelStats getShovelStats(const Geometry& shovel) const;
+  /// Name of the bool geometry property that marks a deformer (used by the ground cutting force).
+  static constexpr const char* DeformerProperty = "DynamicHeightFieldDeformer";
+  // --- end shovel read-outs ----------------------------------------------------------------------------------
+
   /// Vertices loaded by contacts in the last step, and how many of them yielded.
   size_t getNumLoadedVertices() const { return numLoaded_; }
   size_t getNumYieldedVertices() const { return numYielded_; }
@@ -485,6 +538,14 @@ class Terrain : public Model {
   };
   std::vector<ParticleMaterialCache> particleMaterials_;
   TerrainDigStats digStats_;
+  // --- shovel read-outs and ground cutting force (terrain_shovel.cpp) ---------------------------------------
+  void updateShovelStats();
+  /// Contact listener part: the ground cutting force on a shovel-terrain contact (TerrainDataInterface).
+  void applyGroundCuttingForce(GeometryContact& contact, const Geometry& other);
+  std::vector<TerrainShovelStats> shovelStats_;
+  /// Sum of the normal forces of each shovel's terrain contact points last step (N), for the deformer case.
+  std::vector<std::pair<const Geometry*, Real>> shovelNormalForce_;
+  // --- end shovel read-outs ----------------------------------------------------------------------------------
 };
 using TerrainRef = std::shared_ptr<Terrain>;
 
