@@ -62,7 +62,7 @@ TerrainDigScene buildTerrainDig(const TerrainDigParams& p) {
   // The bucket, in its body frame: blade centre at the origin, forward +x, up +z.
   const Real L = p.bucketLength, W = p.bucketWidth, H = p.bucketHeight, t = p.plate;
   s.bucket = std::make_shared<RigidBody>("bucket");
-  s.blade = std::make_shared<Geometry>(std::make_shared<Box>(Vec3(0.5 * L, 0.5 * W + t, 0.5 * t)), "blade");
+  s.blade = std::make_shared<Geometry>(std::make_shared<Box>(Vec3(0.5 * L, 0.5 * W, 0.5 * t)), "blade");
   s.blade->getPropertyContainer().addPropertyVec3(Terrain::ShovelUpProperty, Vec3(0, 0, t));
   s.blade->getPropertyContainer().addPropertyVec3(Terrain::ShovelForwardProperty, Vec3(0.5 * L, 0, 0));
   s.bucket->add(s.blade);
