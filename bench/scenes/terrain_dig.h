@@ -41,11 +41,11 @@ struct TerrainDigParams {
   Real particleRadius = 0.015;    ///< m, <= cell
   Real mergeVelocity = 0.1;       ///< m/s
   // Bucket (inner dimensions, m): blade length along x, width along y, wall height, plate thickness.
-  Real bucketLength = 0.5, bucketWidth = 0.6, bucketHeight = 0.35, plate = 0.02;
+  Real bucketLength = 0.6, bucketWidth = 0.6, bucketHeight = 0.45, plate = 0.02;
   Real startX = -1.2;             ///< m, bucket (blade centre) x at the start
   Real startZ = 0.03;             ///< m, blade centre height at the start (above the surface)
-  Real depth = 0.1;               ///< m, trench depth (the blade's centre plane goes this deep)
-  Real trenchLength = 1.2;        ///< m, drag distance
+  Real depth = 0.08;              ///< m, trench depth (the blade's centre plane goes this deep)
+  Real trenchLength = 0.7;        ///< m, drag distance
   Real digSpeed = 0.4;            ///< m/s
   Real settleSeconds = 4.0;       ///< after the dump
   /// The lighter cut scree_demo runs: 20 mm particles, a 0.8 m trench, 3 s of settling.
