@@ -137,6 +137,10 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
               if (j <= i) return;
               const Vec3 d = xi - x[j];
               const Real dist2 = d.squaredNorm();
+              // Cheap reject first: beyond the largest margin (reach) the pair can never touch, and most
+              // stencil candidates are that far; the relative speed (a square root) is read only for the rest.
+              const Real far = ri + r[j] + reach;
+              if (dist2 >= far * far) return;
               const Real pairMargin = std::min(h * (v[i] - v[j]).norm() + margin_, reach);
               const Real lim = ri + r[j] + pairMargin;
               if (dist2 >= lim * lim) return;
