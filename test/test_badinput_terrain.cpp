@@ -154,4 +154,21 @@ TEST_SUITE("terrain bad input") {
     CHECK(t->getVolumeLedger().total() == doctest::Approx(t->computeHeightFieldVolume() +
                                                           t->getVolumeLedger().compressed));
   }
+
+  TEST_CASE("ground cutting force: negative or non-finite throws and leaves the value unchanged") {
+    TestWorld w;
+    TerrainRef t = addFlatTerrain(w, 6, 5.0);
+    TerrainDataInterface& di = t->getDataInterface();
+    CHECK(di.getShovelGroundCuttingForce() == 0);
+    di.setShovelGroundCuttingForce(2.5);
+    const Snapshot before(*t);
+    CHECK_REJECTED(di.setShovelGroundCuttingForce(-1), "force = -1");
+    CHECK_REJECTED(di.setShovelGroundCuttingForce(kNaN), "force = nan");
+    CHECK_REJECTED(di.setShovelGroundCuttingForce(std::numeric_limits<Real>::infinity()), "force = inf");
+    CHECK_REJECTED(di.setShovelGroundCuttingForce(-std::numeric_limits<Real>::infinity()), "force = -inf");
+    CHECK(di.getShovelGroundCuttingForce() == 2.5);
+    CHECK(Snapshot(*t) == before);
+    CHECK_NOTHROW(di.setShovelGroundCuttingForce(0));
+    CHECK(di.getShovelGroundCuttingForce() == 0);
+  }
 }

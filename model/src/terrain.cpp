@@ -235,6 +235,7 @@ void Terrain::modifyContact(GeometryContact& c) {
       p.youngsModulus = E * m;
     }
   }
+  applyGroundCuttingForce(c, *other);  // shovels only (terrain_shovel.cpp)
 }
 
 void Terrain::compressVertex(size_t v, Real dz, Real newMultiplier, Real dc) {
@@ -298,6 +299,7 @@ void Terrain::postStep() {
   reconcileExternalEdits();
   Simulation* sim = getSimulation();
   if (!sim) return;
+  updateShovelStats();  // digging force and fill read-outs (terrain_shovel.cpp)
 
   // 1. Gather each contact point's normal load (along the field's +z) and normal stiffness (the point's Young's
   //    modulus, N/m) onto the vertices of its triangle, by barycentric weights.

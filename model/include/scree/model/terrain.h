@@ -184,6 +184,41 @@ struct TerrainDigStats {
 
 class Terrain;
 
+// ---------------------------------------------------------------------------------------------------------------
+// Shovel read-outs (manual 25.1.1.2; model/src/terrain_shovel.cpp). After each step's solve the terrain's
+// post-step listener records, for every valid shovel geometry in the simulation (any geometry the digging
+// treats as a shovel, whether it touched anything or not):
+//   terrainContactForce   sum over the enabled, non-sensor contact points between the shovel geometry and the
+//                         terrain geometry of the force the solver applied on the shovel (normal + friction,
+//                         world frame, N; adhesion pulling counts with its sign).
+//   particleContactForce  the same over the particle-geometry contacts between the shovel geometry and the
+//                         live particles this terrain made (GranularBodySystem contact lists: the force on the
+//                         particle is normalForce * normal + frictionForce, the shovel feels its negative).
+//                         Particles of other origin are not counted.
+//   fill                  the terrain particles whose centre lies (a) inside the fill box: the union B of the world
+//                         bounding boxes of all geometries on the shovel's body (the shovel geometry's own box
+//                         for a static shovel; a bucket's plates together bound its inside), with its top raised
+//                         by B's larger horizontal side, and (b) on the up side of the shovel plane (the cutting
+//                         plane through the tip moved up by the blade thickness: the plane particles are created
+//                         above). fillVolume sums their carried volumes (m^3), fillParticles counts them.
+//                         Why a box: a shovel is any set of geometries; the box is defined for all of them and its
+//                         horizontal extent is the footprint the cut uses. Why raised: a flat blade's own box is
+//                         as thin as the blade, and a heap on a footprint of side s stands lower than s for any
+//                         repose angle below 63 degrees, so the raised box holds what a blade or bucket carries.
+//                         (b) keeps out what lies under or behind the blade. World z is taken as up.
+// Geometry poses are this step's final ones (after integration). A shovel that is not valid (or no longer in
+// the simulation) has no entry; getShovelStats then returns zeros with `shovel` set.
+// ---------------------------------------------------------------------------------------------------------------
+/// Per shovel, last step (see the file comment): forces on the shovel (world frame, N) and its fill.
+struct TerrainShovelStats {
+  const Geometry* shovel = nullptr;
+  Vec3 terrainContactForce = Vec3::Zero();   ///< from contacts with the terrain geometry
+  Vec3 particleContactForce = Vec3::Zero();  ///< from contacts with terrain particles
+  Real fillVolume = 0;                       ///< soil volume of the terrain particles in the shovel (m^3)
+  size_t fillParticles = 0;
+  Vec3 diggingForce() const { return terrainContactForce + particleContactForce; }
+};
+
 /// Particle attributes of a terrain (manual 25.1.2.8): the radius of particles made from now on.
 class TerrainParticleAttributes {
  public:
@@ -283,6 +318,15 @@ class Terrain : public Model {
   Real getParticleCarriedVolume(size_t id) const;
   const TerrainDigStats& getLastStepDigStats() const { return digStats_; }
 
+  // --- shovel read-outs and ground cutting force (terrain_shovel.cpp; see TerrainShovelStats) ----------------
+  /// One entry per valid shovel geometry of the last step, in the order the simulation lists them.
+  const std::vector<TerrainShovelStats>& getLastStepShovelStats() const { return shovelStats_; }
+  /// The shovel's entry of the last step; zeros (with `shovel` set) when it was not seen last step.
+  TerrainShovelStats getShovelStats(const Geometry& shovel) const;
+  /// Name of the bool geometry property that marks a deformer (used by the ground cutting force).
+  static constexpr const char* DeformerProperty = "DynamicHeightFieldDeformer";
+  // --- end shovel read-outs ----------------------------------------------------------------------------------
+
   /// Vertices loaded by contacts in the last step, and how many of them yielded.
   size_t getNumLoadedVertices() const { return numLoaded_; }
   size_t getNumYieldedVertices() const { return numYielded_; }
@@ -352,6 +396,14 @@ class Terrain : public Model {
   };
   std::vector<ParticleMaterialCache> particleMaterials_;
   TerrainDigStats digStats_;
+  // --- shovel read-outs and ground cutting force (terrain_shovel.cpp) ---------------------------------------
+  void updateShovelStats();
+  /// Contact listener part: the ground cutting force on a shovel-terrain contact (TerrainDataInterface).
+  void applyGroundCuttingForce(GeometryContact& contact, const Geometry& other);
+  std::vector<TerrainShovelStats> shovelStats_;
+  /// Sum of the normal forces of each shovel's terrain contact points last step (N), for the deformer case.
+  std::vector<std::pair<const Geometry*, Real>> shovelNormalForce_;
+  // --- end shovel read-outs ----------------------------------------------------------------------------------
 };
 using TerrainRef = std::shared_ptr<Terrain>;
 

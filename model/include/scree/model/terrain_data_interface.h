@@ -129,6 +129,25 @@ class TerrainDataInterface {
   virtual void setYieldPressure(Real pressure);
   Real getYieldPressure() const { return yieldPressure_; }
 
+  // --- ground cutting force (manual 25.1.2.13; implemented in terrain_shovel.cpp) -----------------------------
+  /// Extra resistance a shovel meets where it touches the terrain (finite, >= 0; default 0 = no effect; otherwise
+  /// std::invalid_argument, unchanged). Read on every shovel-terrain contact point by the terrain's contact
+  /// listener, so it may change at run time (a full bucket digs harder):
+  ///  - a shovel that is also a deformer (bool geometry property Terrain::DeformerProperty true): a force, N -
+  ///    the contact's friction bound grows by this much (a friction-like force, so it resists sliding and never
+  ///    drives the shovel). Each point's friction coefficient is raised by value / N_last, N_last the sum of the
+  ///    normal forces of the shovel's terrain contact points in the last step, so the points' bounds add up to
+  ///    mu N + value N / N_last (= mu N + value once the normal force is steady; nothing on the first step of a
+  ///    touch, when N_last = 0).
+  ///  - any other shovel: a dimensionless scale - each point's friction coefficient mu(shovel, terrain) becomes
+  ///    mu (1 + value), so the friction bound is (1 + value) mu N. Why 1 + value and not value: 0 must leave
+  ///    the contact as it was (the default), and a scale of 0 would remove its friction.
+  /// Both act through the contact points' friction (the solver's friction rows), hence in every tangential
+  /// direction: a shovel moving along its forward direction meets it as a force against that motion.
+  virtual void setShovelGroundCuttingForce(Real force);
+  Real getShovelGroundCuttingForce() const { return groundCuttingForce_; }
+  // --- end ground cutting force -------------------------------------------------------------------------------
+
   /// The law's multiplier for compression c and deformability d under cap M (see terrain.h).
   static Real multiplier(Real compression, Real deformability, Real maxMultiplier);
 
@@ -159,6 +178,7 @@ class TerrainDataInterface {
   Real depthForMax_ = defaultDepthForMaxCompression;
   Real maxChange_ = defaultMaxYoungsChangePerTimestep;
   Real yieldPressure_ = defaultYieldPressure;
+  Real groundCuttingForce_ = 0;  ///< ground cutting force (terrain_shovel.cpp)
 };
 
 }  // namespace scree
