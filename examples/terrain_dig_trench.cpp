@@ -1,5 +1,5 @@
 // terrain_dig_trench: the trench scene of bench/scenes/terrain_dig.h - a kinematic bucket (blade, back plate and
-// sides) digs a 0.1 m deep, 1.2 m long trench in a Terrain, lifts the soil, dumps it by turning its tip down, and
+// sides) digs an 8 cm deep, 0.7 m long trench in a Terrain, lifts the soil, dumps it by turning its tip down, and
 // the heap merges back into the height field. Prints per phase the particles created and merged, the live
 // particles, and the soil-volume ledger (its total stays constant: digging moves soil heightField -> pending ->
 // particles -> heightField, it never creates or loses any).

@@ -12,7 +12,7 @@
 // rolling resistance 0.3 (the particles copy the soil's parameters; without rolling resistance a sphere the
 // bucket set rolling rolls on forever, docs/terrain.md). The defaults size the dig so that it produces over
 // 5,000 live particles (r = 15 mm, 9.5e-6 m^3 of soil each; a 0.6 x 0.6 x 0.45 m bucket lowered 8 cm into the
-// ground and dragged 0.7 m: about 0.062 m^3 of soil, 6,700 live at the peak). Why the bucket is so much larger
+// ground and dragged 0.7 m: about 0.07 m^3 of soil, 7,700 particles made, 6,700 live at the peak). Why the bucket is so much larger
 // than the soil: the particles overlap on their lattice but pile loosely, taking about 2.5 times the soil's volume
 // (sphere volume 1.5 V at a packing fraction near 0.6), and a full bucket grows a column of new particles over its
 // front that falls off. demoParams() is a lighter cut (larger particles, shorter trench).
