@@ -5,7 +5,8 @@
 // pendulum chain on ball joints, a suction gripper pick-and-place (demo_suction.h) and a granular pile poured
 // from a nozzle (demo_granular.h). Prints a one-line summary per simulated second. Then a four-wheeled vehicle on
 // TwoBodyTireModel tires drives over a bump (demo_vehicle.h), and the same vehicle drives forward, back and forward
-// over soft ground (a deformable Terrain) and prints how much deeper its ruts get per pass (demo_terrain.h).
+// over soft ground (a deformable Terrain) and prints how much deeper its ruts get per pass (demo_terrain.h), and a
+// bucket digs a trench in a Terrain, lifts and dumps the soil, and the heap merges back (demo_dig.h).
 //
 // Usage: scree_demo [seconds=5] [iterations=16]
 #include <cmath>
@@ -20,6 +21,7 @@
 #include "demo_suction.h"
 #include "demo_granular.h"
 #include "demo_terrain.h"
+#include "demo_dig.h"
 
 using namespace scree;
 
@@ -162,5 +164,6 @@ int main(int argc, char** argv) {
   const auto& report = sim.getLastStepReport();
   const bool vehicleOk = runVehicleDemo(std::min(seconds, 4.0));
   const bool terrainOk = runTerrainDemo(std::min(seconds, 5.0) / 2.5);
-  return report.ok() && vehicleOk && terrainOk ? 0 : 1;
+  const bool digOk = runDigDemo();
+  return report.ok() && vehicleOk && terrainOk && digOk ? 0 : 1;
 }

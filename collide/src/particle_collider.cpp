@@ -17,6 +17,10 @@ namespace {
 // Particles per work chunk. Chunks, not threads, own output buffers: the merged order is independent of the
 // thread count.
 constexpr size_t kChunk = 512;
+// Loops over fewer chunks than this run on the calling thread: a fork/join costs more than a few chunks of work,
+// and far more when the machine is busy (a thread that has to wait for its descheduled peer). The chunks and
+// their merge order are the same either way, so the results do not change.
+constexpr size_t kParallelChunks = 4;
 
 // Cell coordinate of a position component; clamped so that a particle far away (1e9 cells) cannot overflow
 // the integer conversion (it only shares a cell with other far-away particles).
@@ -98,7 +102,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
   m.cy.resize(n);
   m.cz.resize(n);
   m.bucketOf.resize(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelChunks * kChunk)
   for (size_t i = 0; i < n; ++i) {
     m.cx[i] = cellCoord(x[i].x(), m.invCell);
     m.cy[i] = cellCoord(x[i].y(), m.invCell);
@@ -120,7 +124,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
   // ---- particle pairs ----------------------------------------------------------------------------------------
   const size_t numChunks = (n + kChunk - 1) / kChunk;
   if (m.chunkOut.size() < numChunks) m.chunkOut.resize(numChunks);
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (numChunks >= kParallelChunks)
   for (size_t c = 0; c < numChunks; ++c) {
     auto& out = m.chunkOut[c];
     out.clear();
@@ -137,6 +141,10 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
               if (j <= i) return;
               const Vec3 d = xi - x[j];
               const Real dist2 = d.squaredNorm();
+              // Cheap reject first: beyond the largest margin (reach) the pair can never touch, and most
+              // stencil candidates are that far; the relative speed (a square root) is read only for the rest.
+              const Real far = ri + r[j] + reach;
+              if (dist2 >= far * far) return;
               const Real pairMargin = std::min(h * (v[i] - v[j]).norm() + margin_, reach);
               const Real lim = ri + r[j] + pairMargin;
               if (dist2 >= lim * lim) return;
@@ -210,7 +218,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
     const size_t nc = cand.size();
     const size_t numGChunks = (nc + kChunk - 1) / kChunk;
     if (m.chunkOut.size() < numGChunks) m.chunkOut.resize(numGChunks);
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (numGChunks >= kParallelChunks)
     for (size_t c = 0; c < numGChunks; ++c) {
       auto& out = m.chunkOut[c];
       out.clear();

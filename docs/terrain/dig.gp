@@ -4,7 +4,7 @@ if (!exists("d")) d = "/tmp/dig"
 set terminal pngcairo size 1000,760 font ",10"
 set output "docs/terrain/dig.png"
 set multiplot layout 2,2 title "A kinematic bucket digs a trench; the soil becomes particles and merges back (side view, y = 0)"
-set xrange [-1:1]; set yrange [-0.2:0.6]; set size ratio -1
+set xrange [-2:2]; set yrange [-0.3:1.0]; set size ratio -1
 set xlabel "x (m)"; set ylabel "z (m)"; set key top left
 do for [ph in "dig lift dump settle"] {
   set title "end of ".ph

@@ -48,7 +48,11 @@ class Terrain::ContactListener : public ContactEventListener {
 class Terrain::StepListener : public StepEventListener {
  public:
   explicit StepListener(Terrain* t) : StepEventListener(PRE_COLLIDE | POST_STEP), t_(t) {}
-  void preCollide(const TimeStamp&) override { t_->preCollide(); }
+  void preCollide(const TimeStamp&) override {
+    const auto t0 = Clock::now();
+    t_->preCollide();
+    t_->lastPreCollideTime_ = secondsSince(t0);
+  }
   void post(const TimeStamp&) override { t_->postStep(); }
 
  private:

@@ -53,17 +53,28 @@ std::string Terrain::checkShovelVectors(const Vec3& up, const Vec3& forward) {
 
 namespace {
 /// "" when g is a valid shovel; "-" when it has neither property (not meant as a shovel); else the problem.
+// The property names as strings made once: PropertyContainer looks names up by std::string, and a name longer
+// than the small-string buffer would otherwise be allocated for every lookup, for every geometry, every step.
+const std::string& upKey() {
+  static const std::string k = Terrain::ShovelUpProperty;
+  return k;
+}
+const std::string& forwardKey() {
+  static const std::string k = Terrain::ShovelForwardProperty;
+  return k;
+}
+
 std::string shovelProblem(const Geometry& g) {
   const PropertyContainer& pc = g.getPropertyContainer();
-  const bool hasUp = pc.hasProperty(Terrain::ShovelUpProperty);
-  const bool hasFwd = pc.hasProperty(Terrain::ShovelForwardProperty);
+  if (pc.size() == 0) return "-";  // the common case: no properties at all
+  const bool hasUp = pc.hasProperty(upKey());
+  const bool hasFwd = pc.hasProperty(forwardKey());
   if (!hasUp && !hasFwd) return "-";
   if (!hasUp) return "ShovelUpProperty is missing";
   if (!hasFwd) return "ShovelForwardProperty is missing";
-  if (!pc.hasPropertyVec3(Terrain::ShovelUpProperty)) return "ShovelUpProperty is not a Vec3";
-  if (!pc.hasPropertyVec3(Terrain::ShovelForwardProperty)) return "ShovelForwardProperty is not a Vec3";
-  return Terrain::checkShovelVectors(pc.getPropertyVec3(Terrain::ShovelUpProperty),
-                                     pc.getPropertyVec3(Terrain::ShovelForwardProperty));
+  if (!pc.hasPropertyVec3(upKey())) return "ShovelUpProperty is not a Vec3";
+  if (!pc.hasPropertyVec3(forwardKey())) return "ShovelForwardProperty is not a Vec3";
+  return Terrain::checkShovelVectors(pc.getPropertyVec3(upKey()), pc.getPropertyVec3(forwardKey()));
 }
 }  // namespace
 
@@ -139,8 +150,8 @@ void Terrain::findShovels(std::vector<Shovel>& out) {
     s.geometry = &g;
     const Transform& G = g.getTransform();
     const PropertyContainer& pc = g.getPropertyContainer();
-    const Vec3 up = G.rotate(pc.getPropertyVec3(ShovelUpProperty));
-    const Vec3 fwd = G.rotate(pc.getPropertyVec3(ShovelForwardProperty));
+    const Vec3 up = G.rotate(pc.getPropertyVec3(upKey()));
+    const Vec3 fwd = G.rotate(pc.getPropertyVec3(forwardKey()));
     s.thickness = up.norm();
     s.upL = T.rotateInverse(up / s.thickness);
     s.tipL = T.applyInverse(G.p + fwd);
@@ -294,9 +305,17 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
   auto keyOf = [&](const Vec3& p) {
     return CellKey{(long long)std::floor(p.x() / a), (long long)std::floor(p.y() / a), (long long)std::floor(p.z() / a)};
   };
+  // Only particles that can be within d of a site: sites lie over the shovel's world box (x, y), so a particle
+  // farther than d outside it in x or y never blocks one (most live particles, once a heap is dumped elsewhere).
+  const Real reachXY = d;
+  grid.reserve(particles_.size() / 4 + 16);
   for (const auto& [id, vol] : particles_)
     if (gbs.isValid(id)) {
-      const Vec3 p = T.applyInverse(gbs.getPosition(id));
+      const Vec3 pw = gbs.getPosition(id);
+      if (pw.x() < s.box.lo.x() - reachXY || pw.x() > s.box.hi.x() + reachXY || pw.y() < s.box.lo.y() - reachXY ||
+          pw.y() > s.box.hi.y() + reachXY)
+        continue;
+      const Vec3 p = T.applyInverse(pw);
       grid[keyOf(p)].push_back(p);
     }
   auto free = [&](const Vec3& p) {

@@ -451,8 +451,9 @@ class Terrain : public Model {
   /// Vertices loaded by contacts in the last step, and how many of them yielded.
   size_t getNumLoadedVertices() const { return numLoaded_; }
   size_t getNumYieldedVertices() const { return numYielded_; }
-  /// Wall-clock time of the terrain's own work in the last step (its contact and post-step listeners), s.
-  double getLastStepTime() const { return lastContactTime_ + lastPostTime_; }
+  /// Wall-clock time of the terrain's own work in the last step (its pre-collide listener - digging: shovels,
+  /// the cut, particle creation and merging - and its contact and post-step listeners), s.
+  double getLastStepTime() const { return lastPreCollideTime_ + lastContactTime_ + lastPostTime_; }
 
  protected:
   void onAdd(Simulation& sim) override;
@@ -524,6 +525,7 @@ class Terrain : public Model {
   double lastAvalancheTime_ = 0;
   class EditBatch;
   EditBatch* editBatch_ = nullptr;   ///< the open batch of height edits while avalanches run
+  double lastPreCollideTime_ = 0;  ///< s, the pre-collide listener (digging) of the last step
   // Digging.
   Real minDigAngle_ = 3.14159265358979323846 / 10;
   Real mergeVelocity_ = 0.1;

@@ -1,0 +1,126 @@
+// Cost of digging (issue 16): the trench scene of bench/scenes/terrain_dig.h (kinematic 0.6 m wide bucket digs an
+// 8 cm deep, 0.7 m long trench in 0.05 m cells, 15 mm particles, 6,700 live at the peak; lifts, dumps, 4 s of
+// settling) at h = 1/60 s, 10 iterations, on 1 and 2 threads. Figures and where the time goes: docs/terrain.md,
+// "Digging cost". Goal (issue 16): >= 60 steps/s (<= 16.7 ms/step) with >= 5,000 live
+// particles on one core.
+//
+// One benchmark iteration is the whole scene (Iterations(1)); each step is timed with std::chrono around
+// stepForward. Counters (ms are medians over the steps named):
+//   ms_all        every step of the run
+//   ms_dig        the steps of the lower and dig phases
+//   ms_5k         the steps that start with >= 5,000 live particles; n_5k how many there were
+//   cpu_5k        as ms_5k in process CPU time (all threads; on one thread: the time the step really ran,
+//                 robust to other processes on the shared machine; on two threads the sum of both)
+//   goal_ratio    ms_5k / 16.7 (below 1: the goal is met)
+//   live_max      most live particles in any step; created, merged: the totals over the run
+//   contacts_5k   particle contact points (units) per step, mean over the >= 5,000 steps
+//   terrain_ms    the terrain's own work (Terrain::getLastStepTime: its contact, pre-collide and post-step
+//                 listeners), median over the >= 5,000 steps
+//   st_<stage>    Simulation::getTimings() per stage, mean over the >= 5,000 steps (ms); the stages add up to
+//                 the step
+//   drift         |ledger total - start| / start at the end (the soil is conserved)
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <vector>
+
+#include "scenes/terrain_dig.h"
+
+namespace {
+using namespace scree;
+using namespace scree::scenes;
+using Clock = std::chrono::steady_clock;
+
+/// CPU time of the whole process (all threads), ms: unlike the wall clock it does not count the time the
+/// shared machine gave to other processes.
+double cpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+void BM_terrain_dig(benchmark::State& state) {
+  const int threads = int(state.range(0));
+  setNumThreads(threads);
+  for (auto _ : state) {
+    state.PauseTiming();
+    TerrainDigScene s = buildTerrainDig();
+    const Real total0 = s.terrain->getVolumeLedger().total();
+    state.ResumeTiming();
+    std::vector<double> all, dig, big, bigCpu, terrainBig;
+    StepTimings sum;
+    size_t liveMax = 0, created = 0, merged = 0;
+    double contacts = 0;
+    const int n = s.totalSteps();
+    for (int i = 0; i < n; ++i) {
+      const size_t live = s.sim->getGranularBodySystem().numParticles();
+      const size_t phase = s.currentPhase();
+      const auto t0 = Clock::now();
+      const double c0 = cpuMs();
+      s.step();
+      const double cpu = cpuMs() - c0;
+      const double ms = std::chrono::duration<double>(Clock::now() - t0).count() * 1e3;
+      all.push_back(ms);
+      if (phase <= 1) dig.push_back(ms);
+      liveMax = std::max(liveMax, s.sim->getGranularBodySystem().numParticles());
+      created += s.terrain->getLastStepDigStats().particlesCreated;
+      merged += s.terrain->getLastStepDigStats().particlesMerged;
+      if (live >= 5000) {
+        big.push_back(ms);
+        bigCpu.push_back(cpu);
+        terrainBig.push_back(s.terrain->getLastStepTime() * 1e3);
+        contacts += double(s.sim->getStepStats().numParticleContacts);
+        const StepTimings t = s.sim->getTimings();
+        sum.preCollide += t.preCollide;
+        sum.collideGeometries += t.collideGeometries + t.syncGeometries + t.resolveMaterials;
+        sum.collideParticles += t.collideParticles;
+        sum.contactEvents += t.contactEvents;
+        sum.particleRows += t.particleRows + t.contactRows + t.constraintRows + t.applyForces;
+        sum.solve += t.solve;
+        sum.integrateMotion += t.integrateMotion + t.storeResults + t.projectPositions + t.checkFinite;
+        sum.post += t.post + t.pre;
+        sum.compactParticles += t.compactParticles;
+      }
+    }
+    state.PauseTiming();
+    const double nb = std::max<double>(1, double(big.size()));
+    state.counters["ms_all"] = median(all);
+    state.counters["ms_dig"] = median(dig);
+    state.counters["ms_5k"] = median(big);
+    state.counters["cpu_5k"] = median(bigCpu);
+    state.counters["n_5k"] = double(big.size());
+    state.counters["goal_ratio"] = median(big) / (1000.0 / 60);
+    state.counters["live_max"] = double(liveMax);
+    state.counters["contacts_5k"] = contacts / nb;
+    state.counters["created"] = double(created);
+    state.counters["merged"] = double(merged);
+    state.counters["terrain_ms"] = median(terrainBig);
+    state.counters["st_preCollide"] = sum.preCollide / nb;
+    state.counters["st_collideGeom"] = sum.collideGeometries / nb;
+    state.counters["st_collidePart"] = sum.collideParticles / nb;
+    state.counters["st_events"] = sum.contactEvents / nb;
+    state.counters["st_rows"] = sum.particleRows / nb;
+    state.counters["st_solve"] = sum.solve / nb;
+    state.counters["st_integrate"] = sum.integrateMotion / nb;
+    state.counters["st_pre_post"] = sum.post / nb;
+    state.counters["st_compact"] = sum.compactParticles / nb;
+    state.counters["drift"] = std::abs(s.terrain->getVolumeLedger().total() - total0) / total0;
+    state.ResumeTiming();
+  }
+  state.counters["threads"] = threads;
+  setNumThreads(0);
+}
+BENCHMARK(BM_terrain_dig)->Arg(1)->Arg(2)->ArgName("threads")->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
