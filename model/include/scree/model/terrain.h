@@ -192,10 +192,15 @@ class TerrainParticleAttributes {
   void setParticleRadius(Real radius);
   /// The set radius, or the default s / (2 (3 sqrt2 - 2)) (lattice at twice the height-field resolution).
   Real getParticleRadius() const;
+  /// Particle-particle contact E = the vertex material's E x multiplier (manual 25.1.2.11); finite and > 0
+  /// (default 1), otherwise std::invalid_argument, unchanged. Applies to the particles that exist too.
+  void setParticleYoungsModulusMultiplier(Real multiplier);
+  Real getParticleYoungsModulusMultiplier() const { return youngsMultiplier_; }
 
  private:
   const Terrain& terrain_;
   Real radius_ = 0;  ///< 0: the default
+  Real youngsMultiplier_ = 1;
 };
 
 class Terrain : public Model {
@@ -297,6 +302,7 @@ class Terrain : public Model {
   class ContactListener;
   class StepListener;
   friend class TerrainDataInterface;
+  friend class TerrainParticleAttributes;
 
   void init();
   /// Triangle under a height-field-frame point: the three vertex indices and barycentric weights. False outside.
@@ -310,6 +316,16 @@ class Terrain : public Model {
   void cut(const Shovel& shovel);
   void createParticles(const Shovel& shovel, size_t i0, size_t i1, size_t j0, size_t j1);
   MaterialRef particleMaterial(size_t v);
+  // --- particle contact materials (terrain_particle_materials.cpp) ---
+  struct ParticleMaterialCache;
+  /// (Re)writes the particle-particle contact material of `c` and its contact materials with every external
+  /// material, and unregisters those of external materials no longer registered.
+  void syncParticleContactMaterials(ParticleMaterialCache& c);
+  /// syncParticleContactMaterials for every particle material (after a setting changed).
+  void syncParticleContactMaterials();
+  /// The FAQ warning: a terrain particle touching a geometry whose material is not external (once per material).
+  void checkParticleContacts(const std::vector<ParticleContact>& particleGeometry);
+
   /// Lowers vertex v by dz > 0 as compression: height, c (and m), and the ledger's heightField -> compressed.
   void compressVertex(size_t v, Real dz, Real newMultiplier, Real dc);
   /// Books direct HeightField edits (dirty rectangle) into the heightField account.
@@ -347,9 +363,15 @@ class Terrain : public Model {
     const Material* source = nullptr;
     Real radius = 0, adhesion = 0, density = 0;
     MaterialRef material;
+    // Particle contact materials (terrain_particle_materials.cpp).
+    MaterialRef sourceRef;                                       ///< keeps source alive for its parameters
+    ContactMaterialRef self;                                     ///< (material, material)
+    std::vector<std::pair<MaterialRef, ContactMaterialRef>> external;  ///< (external material, its contact)
   };
   std::vector<ParticleMaterialCache> particleMaterials_;
   TerrainDigStats digStats_;
+  // Particle contact materials (terrain_particle_materials.cpp).
+  std::vector<const Material*> warnedMaterials_;  ///< the FAQ warning, logged once per material
 };
 using TerrainRef = std::shared_ptr<Terrain>;
 
