@@ -110,6 +110,25 @@ void Terrain::syncParticleContactMaterials(ParticleMaterialCache& c) {
   }
   mm.add(c.self);
 
+  // DIRECT mode: the lump's support by the terrain goes into the direct solve too (SPLIT: normals direct,
+  // friction iterative). The direct solve holds its impulses while the particle sweeps run afterwards, so a
+  // glued lump on ITERATIVE support contacts does not feel them: it falls through them (terrain.h).
+  const MaterialRef groundMat = defaultMaterial();
+  if (c.ground && (di.particleSolveType_ != FrictionModel::DIRECT || c.groundMaterial != groundMat)) {
+    mm.remove(c.ground);
+    c.ground.reset();
+    c.groundMaterial.reset();
+  }
+  if (di.particleSolveType_ == FrictionModel::DIRECT && groundMat && !di.isExternalMaterial(groundMat.get())) {
+    if (!c.ground) c.ground = std::make_shared<ContactMaterial>(c.material, groundMat);
+    c.groundMaterial = groundMat;
+    SurfaceParameters sp;
+    mm.resolve(c.material.get(), groundMat.get(), sp, nullptr);
+    copySurface(sp, *c.ground);
+    c.ground->setSolveType(FrictionModel::SPLIT);
+    mm.add(c.ground);
+  }
+
   // Externals that left: unregister their contact materials.
   for (size_t k = 0; k < c.external.size();) {
     if (di.isExternalMaterial(c.external[k].first.get())) {
@@ -152,6 +171,12 @@ void Terrain::checkParticleContacts(const std::vector<ParticleContact>& pg) {
   const GranularBodySystem& gbs = sim.getGranularBodySystem();
   const std::vector<uint32_t>& index = gbs.materialIndices();
   const std::vector<MaterialRef>& table = gbs.getMaterialTable();
+  auto isTerrainParticle = [&](size_t dense) {
+    const Material* pm = dense < index.size() ? table[index[dense]].get() : nullptr;
+    for (const ParticleMaterialCache& pc : particleMaterials_)
+      if (pc.material.get() == pm) return true;
+    return false;
+  };
   const Material* fallback = sim.getMaterialManager().getDefaultMaterial().get();
   const TerrainDataInterface& di = *data_;
   for (const ParticleContact& c : pg) {
@@ -160,10 +185,8 @@ void Terrain::checkParticleContacts(const std::vector<ParticleContact>& pg) {
     if (di.isExternalMaterial(gm) ||
         std::find(warnedMaterials_.begin(), warnedMaterials_.end(), gm) != warnedMaterials_.end())
       continue;
-    const Material* pm = c.a < index.size() ? table[index[c.a]].get() : nullptr;
-    const auto mine = std::find_if(particleMaterials_.begin(), particleMaterials_.end(),
-                                   [&](const ParticleMaterialCache& pc) { return pc.material.get() == pm; });
-    if (mine == particleMaterials_.end()) continue;
+    if (!isTerrainParticle(c.a)) continue;
+    const Material* pm = table[index[c.a]].get();
     warnedMaterials_.push_back(gm);
     SurfaceParameters sp;
     sim.getMaterialManager().resolve(pm, gm, sp, nullptr);

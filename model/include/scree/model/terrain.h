@@ -367,6 +367,8 @@ class Terrain : public Model {
     MaterialRef sourceRef;                                       ///< keeps source alive for its parameters
     ContactMaterialRef self;                                     ///< (material, material)
     std::vector<std::pair<MaterialRef, ContactMaterialRef>> external;  ///< (external material, its contact)
+    ContactMaterialRef ground;  ///< DIRECT mode: (material, terrain geometry's material), SPLIT; else null
+    MaterialRef groundMaterial;
   };
   std::vector<ParticleMaterialCache> particleMaterials_;
   TerrainDigStats digStats_;
