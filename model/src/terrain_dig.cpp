@@ -239,7 +239,12 @@ MaterialRef Terrain::particleMaterial(size_t v) {
   // Its contact materials - with itself (the vertex material's parameters, the particle adhesion at the
   // lattice's overlap, the Young's multiplier, the particle solve type) and with every external material - are
   // written by syncParticleContactMaterials (terrain_particle_materials.cpp), again whenever a setting changes.
-  particleMaterials_.push_back({src.get(), r, adhesion, density, m, src, nullptr, {}});
+  ParticleMaterialCache entry;
+  entry.source = src.get();
+  entry.radius = r, entry.adhesion = adhesion, entry.density = density;
+  entry.material = m;
+  entry.sourceRef = src;
+  particleMaterials_.push_back(std::move(entry));
   syncParticleContactMaterials(particleMaterials_.back());
   return m;
 }

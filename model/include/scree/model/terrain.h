@@ -142,8 +142,41 @@
 // the triangle under it by the barycentric weights (locked border vertices excluded, the weights renormalised;
 // a vertex rises by its share / its area, c falls by the compression rule, not below 0), and is destroyed:
 // particles -> heightField. A terrain particle the user destroys moves its volume particles -> removed.
-// Not in this part: external materials, the particle Young's multiplier, the ground cutting force, the DIRECT
-// particle friction solve type, the bucket fill and digging force read-outs.
+//
+// External materials and particle solve type (manual 25.1.2.10, 25.1.2.11, 25.1.2.14; FAQ 25.1.3.2, 25.1.3.4;
+// terrain_particle_materials.cpp). Every terrain-particle material (one per source material, radius, particle
+// adhesion and density) has explicit contact materials in the simulation's MaterialManager, rewritten whenever a
+// setting below changes - also for the particles that exist:
+//   * with itself: the source material's parameters, E = source E x the particle Young's multiplier
+//     (TerrainParticleAttributes, default 1), and per the particle friction solve type
+//     (TerrainDataInterface::setParticleFrictionSolveType):
+//       ITERATIVE (default): the particle adhesion (1e-9 N when 0, see above) at rest overlap r(sqrt2 - 1).
+//       DIRECT: friction and adhesion infinite, solve type DIRECT, surface viscosity = the inverse friction
+//         multiplier (default 1) x the source material's surface viscosity; the particle DIRECT mode of the
+//         solver glues the lump (every bond an equality row: one factorisation, no pivot for the bonds). The
+//         rest overlap stays the lattice's r(sqrt2 - 1), not the manual's 0: in Scree the bonds need no pivot
+//         because their bounds are infinite, whatever the overlap, while a rest overlap of 0 would push every
+//         lattice bond from r(3 - sqrt2) apart to 2r - the lump would swell by 26% in size (2x in volume) the
+//         moment it is dug. Also in DIRECT, the particles' contacts with the terrain geometry's material are
+//         SPLIT: the direct solve holds its impulses while the particle sweeps run after it, so a glued lump on
+//         ITERATIVE support contacts hardly feels them (measured: a dug lump on ITERATIVE terrain contacts was
+//         thrown apart within 4 steps, 37 m/s; and on an ITERATIVE, unregistered blade it fell at g).
+//         DIRECT therefore needs the shovel registered as external (its contacts SPLIT).
+//       SPLIT and DIRECT_AND_ITERATIVE are rejected: with infinite friction their friction rows would be
+//         unbounded PGS rows.
+//   * with every external material (TerrainDataInterface::addExternalMaterial, the bucket's steel): the
+//     parameters with which the source material meets it (the user's explicit contact material of the two, or
+//     the combination), with E = max(E_external, E_source), solve type SPLIT (PGS without SuiteSparse, as
+//     everywhere) and the external material's surface viscosity (the bucket sets how friction on it yields,
+//     whatever soil slides on it). removeExternalMaterial unregisters them.
+// Why: particles meet everything else through the combination with the soil's own, soft, parameters - the
+// manual's FAQ failure: they sink into and fall through the bucket, and newly made particles tunnel through the
+// blade. A terrain particle touching a geometry whose material is not external logs one Logger warning per
+// material (naming it, the geometry and addExternalMaterial); the check runs in the terrain's contact listener
+// over the step's particle-geometry contacts and returns at once while the terrain has no particles.
+//
+// Not in this part: the ground cutting force, the bucket fill and digging force read-outs. The DIRECT lump is
+// not yet rigid when dug and carried by a bucket (docs/terrain.md).
 #pragma once
 
 #include <algorithm>
