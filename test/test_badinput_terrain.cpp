@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <tuple>
 #include <vector>
 
 #include "png_test_files.h"
@@ -214,5 +215,42 @@ TEST_SUITE("terrain bad input") {
     CHECK(Snapshot(*t) == before);
     CHECK_NOTHROW(di.setShovelGroundCuttingForce(0));
     CHECK(di.getShovelGroundCuttingForce() == 0);
+  }
+
+  TEST_CASE("particle contact materials: external material, Young's multiplier, particle solve type") {
+    TestWorld w;
+    TerrainRef t = addFlatTerrain(w, 6, 5.0);
+    TerrainDataInterface& di = t->getDataInterface();
+    TerrainParticleAttributes& pa = t->getParticleAttributes();
+    auto steel = std::make_shared<Material>("steel");
+    di.addExternalMaterial(steel);
+    di.setInverseFrictionMultiplier(0.5);
+    pa.setParticleYoungsModulusMultiplier(3);
+    // Everything these setters own, checked unchanged after each rejected call (with the terrain Snapshot).
+    auto state = [&] {
+      return std::make_tuple(di.getExternalMaterials(), di.getParticleFrictionSolveType(),
+                             di.getInverseFrictionMultiplier(), pa.getParticleYoungsModulusMultiplier());
+    };
+    const auto before = state();
+    CHECK_REJECTED(di.addExternalMaterial(nullptr), "material = null");
+    CHECK_REJECTED(pa.setParticleYoungsModulusMultiplier(0), "multiplier = 0");
+    CHECK_REJECTED(pa.setParticleYoungsModulusMultiplier(-2), "multiplier = -2");
+    CHECK_REJECTED(pa.setParticleYoungsModulusMultiplier(kNaN), "multiplier = nan");
+    CHECK_REJECTED(pa.setParticleYoungsModulusMultiplier(std::numeric_limits<Real>::infinity()), "multiplier = inf");
+    CHECK_REJECTED(di.setInverseFrictionMultiplier(-0.1), "inverseMultiplier = -0.1");
+    CHECK_REJECTED(di.setInverseFrictionMultiplier(kNaN), "inverseMultiplier = nan");
+    CHECK_REJECTED(di.setInverseFrictionMultiplier(std::numeric_limits<Real>::infinity()), "inverseMultiplier = inf");
+    CHECK_REJECTED(di.setParticleFrictionSolveType(FrictionModel::SPLIT), "solveType = 3");
+    CHECK_REJECTED(di.setParticleFrictionSolveType(FrictionModel::DIRECT_AND_ITERATIVE), "solveType = 2");
+    CHECK_REJECTED(di.setParticleFrictionSolveType(FrictionModel::SolveType(7)), "solveType = 7");
+    CHECK(state() == before);
+    // Accepted edge values; removing an unknown material is not an error.
+    CHECK_NOTHROW(di.setInverseFrictionMultiplier(0));
+    CHECK_NOTHROW(di.setParticleFrictionSolveType(FrictionModel::DIRECT));
+    CHECK_NOTHROW(pa.setParticleYoungsModulusMultiplier(1e-6));
+    CHECK_FALSE(di.removeExternalMaterial(nullptr));
+    CHECK_FALSE(di.removeExternalMaterial(std::make_shared<Material>("other")));
+    CHECK(di.removeExternalMaterial(steel));
+    CHECK(di.getExternalMaterials().empty());
   }
 }

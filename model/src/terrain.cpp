@@ -31,9 +31,14 @@ HeightFieldRef heightFieldOf(const GeometryRef& g) {
 // (Model::addOwned) before it can go away.
 class Terrain::ContactListener : public ContactEventListener {
  public:
-  explicit ContactListener(Terrain* t) : ContactEventListener(IMPACT | CONTACT), t_(t) {}
+  explicit ContactListener(Terrain* t) : ContactEventListener(IMPACT | CONTACT | PARTICLE_CONTACT), t_(t) {}
   KeepContactPolicy impact(const TimeStamp&, GeometryContact& c) override { return run(c); }
   KeepContactPolicy contact(const TimeStamp&, GeometryContact& c) override { return run(c); }
+  /// The FAQ warning for particles on geometry of a non-external material (terrain_particle_materials.cpp).
+  void particleContacts(const TimeStamp&, std::vector<ParticleContact>&,
+                        std::vector<ParticleContact>& particleGeometry) override {
+    t_->checkParticleContacts(particleGeometry);
+  }
 
  private:
   KeepContactPolicy run(GeometryContact& c) {
@@ -106,6 +111,7 @@ void Terrain::setDataInterface(std::unique_ptr<TerrainDataInterface> di) {
   if (&di->terrain_ != this)
     throw std::invalid_argument("Terrain::setDataInterface: dataInterface is invalid (built for another terrain)");
   data_ = std::move(di);
+  syncParticleContactMaterials();  // the new interface's external materials and particle solve type
 }
 
 MaterialRef Terrain::defaultMaterial() const {
@@ -132,6 +138,7 @@ void Terrain::onAdd(Simulation& sim) {
   }
   addOwned(ContactEventListenerRef(contactListener_));
   addOwned(StepEventListenerRef(stepListener_));
+  syncParticleContactMaterials();  // into this simulation's MaterialManager (terrain_particle_materials.cpp)
 }
 
 void Terrain::onRemove(Simulation&) {}

@@ -18,8 +18,6 @@ constexpr Real kSqrt2 = 1.41421356237309504880;
 constexpr Real kPi = 3.14159265358979323846;
 /// |cos(up, forward)| above this is "not orthogonal".
 constexpr Real kOrthogonalityTolerance = 1e-6;
-/// N: the adhesive force of particle contacts when the material's particle adhesion is 0 (see particleMaterial).
-constexpr Real kNoAdhesion = 1e-9;
 }  // namespace
 
 // ---- particle attributes ------------------------------------------------------------------------------------
@@ -261,14 +259,16 @@ MaterialRef Terrain::particleMaterial(size_t v) {
   static_cast<SurfaceParameters&>(*m) = static_cast<const SurfaceParameters&>(*src);
   m->setAdhesion(0, 0);
   m->setDensity(density * getParticleVolume() / (4.0 / 3.0 * kPi * r * r * r));
-  // Particle-particle contacts: the vertex material's parameters, resting at the lattice's overlap r(sqrt2 - 1)
-  // with the particle adhesion. The contact law applies a rest overlap only to adhesive contacts, so adhesion 0
-  // becomes a negligible kNoAdhesion: lattice neighbours rest where they are made instead of flying apart.
-  auto cm = std::make_shared<ContactMaterial>(m, m);
-  static_cast<SurfaceParameters&>(*cm) = static_cast<const SurfaceParameters&>(*src);
-  cm->setAdhesion(std::max(adhesion, kNoAdhesion), r * (kSqrt2 - 1));
-  getSimulation()->getMaterialManager().add(cm);
-  particleMaterials_.push_back({src.get(), r, adhesion, density, m});
+  // Its contact materials - with itself (the vertex material's parameters, the particle adhesion at the
+  // lattice's overlap, the Young's multiplier, the particle solve type) and with every external material - are
+  // written by syncParticleContactMaterials (terrain_particle_materials.cpp), again whenever a setting changes.
+  ParticleMaterialCache entry;
+  entry.source = src.get();
+  entry.radius = r, entry.adhesion = adhesion, entry.density = density;
+  entry.material = m;
+  entry.sourceRef = src;
+  particleMaterials_.push_back(std::move(entry));
+  syncParticleContactMaterials(particleMaterials_.back());
   return m;
 }
 

@@ -214,8 +214,41 @@
 // the triangle under it by the barycentric weights (locked border vertices excluded, the weights renormalised;
 // a vertex rises by its share / its area, c falls by the compression rule, not below 0), and is destroyed:
 // particles -> heightField. A terrain particle the user destroys moves its volume particles -> removed.
-// Not in this part: external materials, the particle Young's multiplier, the DIRECT particle friction solve type.
+//
+// External materials and particle solve type (manual 25.1.2.10, 25.1.2.11, 25.1.2.14; FAQ 25.1.3.2, 25.1.3.4;
+// terrain_particle_materials.cpp). Every terrain-particle material (one per source material, radius, particle
+// adhesion and density) has explicit contact materials in the simulation's MaterialManager, rewritten whenever a
+// setting below changes - also for the particles that exist:
+//   * with itself: the source material's parameters, E = source E x the particle Young's multiplier
+//     (TerrainParticleAttributes, default 1), and per the particle friction solve type
+//     (TerrainDataInterface::setParticleFrictionSolveType):
+//       ITERATIVE (default): the particle adhesion (1e-9 N when 0, see above) at rest overlap r(sqrt2 - 1).
+//       DIRECT: friction and adhesion infinite, solve type DIRECT, surface viscosity = the inverse friction
+//         multiplier (default 1) x the source material's surface viscosity; the particle DIRECT mode of the
+//         solver glues the lump (every bond an equality row: one factorisation, no pivot for the bonds). The
+//         rest overlap stays the lattice's r(sqrt2 - 1), not the manual's 0: in Scree the bonds need no pivot
+//         because their bounds are infinite, whatever the overlap, while a rest overlap of 0 would push every
+//         lattice bond from r(3 - sqrt2) apart to 2r - the lump would swell by 26% in size (2x in volume) the
+//         moment it is dug. Also in DIRECT, the particles' contacts with the terrain geometry's material are
+//         SPLIT: the direct solve holds its impulses while the particle sweeps run after it, so a glued lump on
+//         ITERATIVE support contacts hardly feels them (measured: a dug lump on ITERATIVE terrain contacts was
+//         thrown apart within 4 steps, 37 m/s; and on an ITERATIVE, unregistered blade it fell at g).
+//         DIRECT therefore needs the shovel registered as external (its contacts SPLIT).
+//       SPLIT and DIRECT_AND_ITERATIVE are rejected: with infinite friction their friction rows would be
+//         unbounded PGS rows.
+//   * with every external material (TerrainDataInterface::addExternalMaterial, the bucket's steel): the
+//     parameters with which the source material meets it (the user's explicit contact material of the two, or
+//     the combination), with E = max(E_external, E_source), solve type SPLIT (PGS without SuiteSparse, as
+//     everywhere) and the external material's surface viscosity (the bucket sets how friction on it yields,
+//     whatever soil slides on it). removeExternalMaterial unregisters them.
+// Why: particles meet everything else through the combination with the soil's own, soft, parameters - the
+// manual's FAQ failure: they sink into and fall through the bucket, and newly made particles tunnel through the
+// blade. A terrain particle touching a geometry whose material is not external logs one Logger warning per
+// material (naming it, the geometry and addExternalMaterial); the check runs in the terrain's contact listener
+// over the step's particle-geometry contacts and returns at once while the terrain has no particles.
+//
 // The shovel read-outs (digging force, fill) and the ground cutting force are below (TerrainShovelStats).
+// Not yet: the DIRECT lump is not rigid when dug and carried by a bucket (docs/terrain.md).
 #pragma once
 
 #include <algorithm>
@@ -310,10 +343,15 @@ class TerrainParticleAttributes {
   void setParticleRadius(Real radius);
   /// The set radius, or the default s / (2 (3 sqrt2 - 2)) (lattice at twice the height-field resolution).
   Real getParticleRadius() const;
+  /// Particle-particle contact E = the vertex material's E x multiplier (manual 25.1.2.11); finite and > 0
+  /// (default 1), otherwise std::invalid_argument, unchanged. Applies to the particles that exist too.
+  void setParticleYoungsModulusMultiplier(Real multiplier);
+  Real getParticleYoungsModulusMultiplier() const { return youngsMultiplier_; }
 
  private:
   const Terrain& terrain_;
   Real radius_ = 0;  ///< 0: the default
+  Real youngsMultiplier_ = 1;
 };
 
 class Terrain : public Model {
@@ -463,6 +501,7 @@ class Terrain : public Model {
   class ContactListener;
   class StepListener;
   friend class TerrainDataInterface;
+  friend class TerrainParticleAttributes;
 
   void init();
   /// Triangle under a height-field-frame point: the three vertex indices and barycentric weights. False outside.
@@ -476,6 +515,16 @@ class Terrain : public Model {
   void cut(const Shovel& shovel);
   void createParticles(const Shovel& shovel, size_t i0, size_t i1, size_t j0, size_t j1);
   MaterialRef particleMaterial(size_t v);
+  // --- particle contact materials (terrain_particle_materials.cpp) ---
+  struct ParticleMaterialCache;
+  /// (Re)writes the particle-particle contact material of `c` and its contact materials with every external
+  /// material, and unregisters those of external materials no longer registered.
+  void syncParticleContactMaterials(ParticleMaterialCache& c);
+  /// syncParticleContactMaterials for every particle material (after a setting changed).
+  void syncParticleContactMaterials();
+  /// The FAQ warning: a terrain particle touching a geometry whose material is not external (once per material).
+  void checkParticleContacts(const std::vector<ParticleContact>& particleGeometry);
+
   /// Lowers vertex v by dz > 0 as compression: height, c (and m), and the ledger's heightField -> compressed.
   void compressVertex(size_t v, Real dz, Real newMultiplier, Real dc);
   /// Books direct HeightField edits (dirty rectangle) into the heightField account.
@@ -537,6 +586,12 @@ class Terrain : public Model {
     const Material* source = nullptr;
     Real radius = 0, adhesion = 0, density = 0;
     MaterialRef material;
+    // Particle contact materials (terrain_particle_materials.cpp).
+    MaterialRef sourceRef;                                       ///< keeps source alive for its parameters
+    ContactMaterialRef self;                                     ///< (material, material)
+    std::vector<std::pair<MaterialRef, ContactMaterialRef>> external;  ///< (external material, its contact)
+    ContactMaterialRef ground;  ///< DIRECT mode: (material, terrain geometry's material), SPLIT; else null
+    MaterialRef groundMaterial;
   };
   std::vector<ParticleMaterialCache> particleMaterials_;
   TerrainDigStats digStats_;
@@ -548,6 +603,8 @@ class Terrain : public Model {
   /// Sum of the normal forces of each shovel's terrain contact points last step (N), for the deformer case.
   std::vector<std::pair<const Geometry*, Real>> shovelNormalForce_;
   // --- end shovel read-outs ----------------------------------------------------------------------------------
+  // Particle contact materials (terrain_particle_materials.cpp).
+  std::vector<const Material*> warnedMaterials_;  ///< the FAQ warning, logged once per material
 };
 using TerrainRef = std::shared_ptr<Terrain>;
 

@@ -151,6 +151,34 @@ class TerrainDataInterface {
   /// The law's multiplier for compression c and deformability d under cap M (see terrain.h).
   static Real multiplier(Real compression, Real deformability, Real maxMultiplier);
 
+  // --- particle contact materials (manual 25.1.2.10, 25.1.2.14; terrain.h "External materials and particle
+  // solve type") ---------------------------------------------------------------------------------------------
+  /// Registers a material that terrain particles meet (a bucket's steel): for every terrain-particle material
+  /// the terrain registers a ContactMaterial (particle material, material) with E = max(E of material, E of the
+  /// terrain material the particle was dug from), solve type SPLIT and the material's surface viscosity - now
+  /// for the particle materials that exist and later for new ones. Null throws std::invalid_argument; adding a
+  /// material twice changes nothing.
+  virtual void addExternalMaterial(MaterialRef material);
+  /// Unregisters it: its particle contact materials leave the MaterialManager. False if it was not registered.
+  virtual bool removeExternalMaterial(const MaterialRef& material);
+  /// In registration order.
+  const std::vector<MaterialRef>& getExternalMaterials() const { return externalMaterials_; }
+  bool isExternalMaterial(const Material* material) const;
+
+  /// How particle-particle contacts are solved: ITERATIVE (default; the particle PGS sweeps) or DIRECT (a glued
+  /// lump in the direct solver: infinite friction and adhesion, solve type DIRECT, surface viscosity = the
+  /// inverse friction multiplier x the terrain material's surface viscosity; terrain.h). SPLIT and
+  /// DIRECT_AND_ITERATIVE (and any other value) throw std::invalid_argument: with infinite friction their
+  /// iterative friction rows would be unbounded PGS rows, so they are not particle modes. Applies to the
+  /// particles that exist too.
+  virtual void setParticleFrictionSolveType(FrictionModel::SolveType solveType);
+  FrictionModel::SolveType getParticleFrictionSolveType() const { return particleSolveType_; }
+  /// Scale of the particle-particle friction compliance in DIRECT mode (finite, >= 0; default 1): surface
+  /// viscosity = multiplier x the terrain material's surface viscosity. Smaller: stiffer friction (0: none of
+  /// the friction rows' compliance). Not used in ITERATIVE mode. Otherwise std::invalid_argument, unchanged.
+  virtual void setInverseFrictionMultiplier(Real inverseMultiplier);
+  Real getInverseFrictionMultiplier() const { return inverseFrictionMultiplier_; }
+
  protected:
   /// Throws std::invalid_argument when (x, y) is not a vertex.
   void checkVertex(const char* where, size_t x, size_t y) const;
@@ -179,6 +207,10 @@ class TerrainDataInterface {
   Real maxChange_ = defaultMaxYoungsChangePerTimestep;
   Real yieldPressure_ = defaultYieldPressure;
   Real groundCuttingForce_ = 0;  ///< ground cutting force (terrain_shovel.cpp)
+  // Particle contact materials (issue 16).
+  std::vector<MaterialRef> externalMaterials_;
+  FrictionModel::SolveType particleSolveType_ = FrictionModel::ITERATIVE;
+  Real inverseFrictionMultiplier_ = 1;
 };
 
 }  // namespace scree
