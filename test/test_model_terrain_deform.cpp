@@ -77,6 +77,7 @@ TEST_CASE("deformer contacts: E_v = E max(1, A / s_v) for two overlap areas, and
     const Real depth = -(box->getPosition().z() - 0.1);
     CAPTURE(depth);
     CAPTURE(predicted);
+    MESSAGE("resting depth " << depth << " m, predicted " << predicted << " m, " << nOrig << " points");
     CHECK(std::abs(depth - predicted) <= 0.02 * predicted);
     // At rest (below the cut-offs) the heights are untouched.
     for (Real hgt : t->getHeightField()->getHeights()) REQUIRE(hgt == 0.5);
@@ -110,6 +111,7 @@ struct PushResult {
   Real meanResistance = 0;        ///< mean horizontal contact force on the blade, N
   Real worstDrift = 0;
   size_t pushed = 0;
+  size_t maxArmed = 0;  ///< most vertices armed for avalanches at once
 };
 
 /// A blade (0.1 m thick along x, 1 m wide, 0.4 m tall box; a deformer with useContactDepth false) driven through
@@ -147,6 +149,7 @@ PushResult pushBlade(Real depth, Real speed = 0.5, Real cutOff = Terrain::defaul
     const Real drift = std::abs(t->getVolumeLedger().total() - total0) / total0;
     r.worstDrift = std::max(r.worstDrift, drift);
     r.pushed += t->getLastStepDeformStats().verticesPushed;
+    r.maxArmed = std::max(r.maxArmed, t->getNumArmedVertices());
     const Real travelled = blade->getPosition().x() - x0;
     // Horizontal points of the deformer contact (friction 0, normal horizontal), once the berm has formed.
     if (travelled > samples[0]) {
@@ -189,6 +192,7 @@ TEST_CASE("deformer blade: the ledger is exact every step, a berm grows ahead, d
   for (const PushResult* r : {&shallow, &deep}) {
     CHECK(r->worstDrift <= 1e-9);
     CHECK(r->pushed > 0);
+    CHECK(r->maxArmed > 0);  // moved vertices arm avalanches (the berm slumps)
     REQUIRE(r->bermHeights.size() == 3);
     MESSAGE("berm heights " << r->bermHeights[0] << " " << r->bermHeights[1] << " " << r->bermHeights[2]
                             << ", resistance " << r->meanResistance << " N");
