@@ -229,3 +229,32 @@ TEST_CASE("deformer blade below the cut-off velocity: heights bit-identical") {
   CHECK(contacts > 0);  // it did touch the soil
   CHECK(t->getHeightField()->getHeights() == before);
 }
+
+TEST_CASE("deformer turning in place: above the angular cut-off it pushes soil (ledger exact), below it nothing") {
+  // A 1 m x 0.1 m blade spinning about z at 1 rad/s over the origin, its bottom 5 cm deep: its centre does not
+  // move (below the velocity cut-off), so only the angular cut-off can start deformation.
+  for (Real cutOffW : {0.5, 2.0}) {
+    CAPTURE(cutOffW);
+    TestWorld w(1.0 / 60, 0.0);
+    w.contactMaterial->setYoungsModulus(1e3);
+    TerrainRef t = addDeformTerrain(w);
+    t->setDynamicHeightFieldCutOffAngularVelocity(cutOffW);
+    const std::vector<Real> before = t->getHeightField()->getHeights();
+    RigidBodyRef blade = addDeformerBox(w, Vec3(0.5, 0.05, 0.2), Vec3(0.03, 0.03, 0.15), 1000, false);
+    auto driver = std::make_shared<LambdaStepListener>([&](const TimeStamp&) {
+      blade->setPosition(Vec3(0.03, 0.03, 0.15));
+      blade->setVelocity(Vec3::Zero());
+      blade->setAngularVelocity(Vec3(0, 0, 1));
+    });
+    w.sim->add(StepEventListenerRef(driver));
+    const Real worst = stepCheckingLedger(w, *t, 60);
+    CHECK(worst <= 1e-9);
+    CHECK(!t->getLastStepDeformerContacts().empty());
+    if (cutOffW < 1) {
+      CHECK(t->getHeightField()->getHeights() != before);
+      CHECK(t->getNumArmedVertices() > 0);
+    } else {
+      CHECK(t->getHeightField()->getHeights() == before);
+    }
+  }
+}
