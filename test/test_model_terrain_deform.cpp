@@ -2,7 +2,8 @@
 // vertical contact's Young's modulus E max(1, A/s_v) for two overlap areas; a deformer box resting with
 // useContactDepth true settles at the depth its vertical contacts' compliance predicts, with false its vertical
 // contacts have zero depth; a blade pushed through soil faster than the cut-off velocity builds a berm ahead with
-// the ledger exact after every step, harder to push the deeper it cuts; below the cut-off nothing moves.
+// the ledger exact after every step, harder to push the deeper it cuts; below the cut-off nothing moves; a
+// blade turning in place deforms only above the angular cut-off.
 #include <doctest/doctest.h>
 
 #include <algorithm>
