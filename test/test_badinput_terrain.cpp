@@ -253,4 +253,36 @@ TEST_SUITE("terrain bad input") {
     CHECK(di.removeExternalMaterial(steel));
     CHECK(di.getExternalMaterials().empty());
   }
+
+  TEST_CASE("deformer settings reject negative scalers and cut-offs and NaN, and leave the settings unchanged") {
+    TestWorld w;
+    TerrainRef t = addFlatTerrain(w, 6, 5.0);
+    t->setEnableDynamicHeightField(true);
+    t->setVerticalYoungsModulusAreaScaler(0.02);
+    t->setHorizontalYoungsModulusAreaScaler(0.003);
+    t->setDynamicHeightFieldCutOffVelocity(0.2);
+    t->setDynamicHeightFieldCutOffAngularVelocity(0.3);
+    const Snapshot snap(*t);
+    auto settingsUnchanged = [&] {
+      CHECK(t->getVerticalYoungsModulusAreaScaler() == 0.02);
+      CHECK(t->getHorizontalYoungsModulusAreaScaler() == 0.003);
+      CHECK(t->getDynamicHeightFieldCutOffVelocity() == 0.2);
+      CHECK(t->getDynamicHeightFieldCutOffAngularVelocity() == 0.3);
+      CHECK(Snapshot(*t) == snap);
+    };
+    CHECK_REJECTED(t->setVerticalYoungsModulusAreaScaler(-0.01), "scale = -0.01");
+    CHECK_REJECTED(t->setVerticalYoungsModulusAreaScaler(0), "scale = 0");
+    CHECK_REJECTED(t->setVerticalYoungsModulusAreaScaler(kNaN), "scale = nan");
+    CHECK_REJECTED(t->setVerticalYoungsModulusAreaScaler(std::numeric_limits<Real>::infinity()), "scale = inf");
+    CHECK_REJECTED(t->setHorizontalYoungsModulusAreaScaler(-1), "scale = -1");
+    CHECK_REJECTED(t->setHorizontalYoungsModulusAreaScaler(kNaN), "scale = nan");
+    CHECK_REJECTED(t->setDynamicHeightFieldCutOffVelocity(-0.5), "cutOffVelocity = -0.5");
+    CHECK_REJECTED(t->setDynamicHeightFieldCutOffVelocity(kNaN), "cutOffVelocity = nan");
+    CHECK_REJECTED(t->setDynamicHeightFieldCutOffAngularVelocity(-2), "cutOffAngularVelocity = -2");
+    CHECK_REJECTED(t->setDynamicHeightFieldCutOffAngularVelocity(kNaN), "cutOffAngularVelocity = nan");
+    settingsUnchanged();
+    // Accepted edge values: a zero cut-off (always deform while moving).
+    CHECK_NOTHROW(t->setDynamicHeightFieldCutOffVelocity(0));
+    CHECK_NOTHROW(t->setDynamicHeightFieldCutOffAngularVelocity(0));
+  }
 }

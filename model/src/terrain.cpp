@@ -243,6 +243,8 @@ void Terrain::modifyContact(GeometryContact& c) {
     }
   }
   applyGroundCuttingForce(c, *other);  // shovels only (terrain_shovel.cpp)
+  // Deformer contacts are rebuilt into vertical and horizontal ones (terrain_deform.cpp).
+  if (dynamicHeightField_ && isGeometryDeformer(*other)) modifyDeformerContact(c, self);
 }
 
 void Terrain::compressVertex(size_t v, Real dz, Real newMultiplier, Real dc) {
@@ -409,6 +411,8 @@ void Terrain::postStep() {
   }
   for (size_t v : loaded_) load_[v] = stiffness_[v] = 0;
   loaded_.clear();
+  // 4. Deformers push the soil they overlap (terrain_deform.cpp), arming avalanches.
+  deformStep();
   // 4. Avalanches of the armed vertices (terrain_avalanche.cpp; nothing while none is armed).
   avalancheStep();
   lastPostTime_ = secondsSince(t0);

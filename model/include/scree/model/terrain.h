@@ -98,8 +98,8 @@
 // Dynamic height field: avalanches and the angle of repose (manual 25.1.2.15, 25.1.2.19, 25.1.2.20)
 // ---------------------------------------------------------------------------------------------------------------
 // setEnableDynamicHeightField(true) turns avalanches on (off by default). Deformer contacts (geometries with the
-// bool property DynamicHeightFieldDeformer, manual 25.1.2.15-25.1.2.18) are NOT built yet: for now the switch
-// only runs avalanches, armed by merging particles and by armAvalanche(x, y). avalancheAll() works either way.
+// bool property DynamicHeightFieldDeformer) are rebuilt and deformers push soil: the "deformers" section below.
+// Avalanches are armed by merging particles, by deformers and by armAvalanche(x, y). avalancheAll() works either way.
 //
 // Arming. A vertex is armed for the avalanche step life time L (setAvalancheStepLifeTime, steps) when a particle
 // merges into it (its three vertices; later also where a deformer touches), or when armAvalanche(x, y) is called
@@ -156,6 +156,47 @@
 // Cost. Armed vertices live in a sparse list (each with its steps left); a step's pass visits them and their 8
 // neighbours, nothing else - no pass over the grid unless avalancheAll is called. Height edits are batched by
 // cluster as for compression, so only the touched tiles' bounds are updated.
+//
+// ---------------------------------------------------------------------------------------------------------------
+// Dynamic height field: deformers (manual 25.1.2.15-25.1.2.18; terrain_deform.cpp)
+// ---------------------------------------------------------------------------------------------------------------
+// A deformer is a geometry with the bool property DynamicHeightFieldDeformer (Terrain::DeformerProperty); its
+// value is useContactDepth. While the dynamic height field is on, every contact of a deformer with the terrain
+// is rebuilt in the contact listener (after the compression law has set each point's E):
+//   - the overlap. From the deformer's world bounding box, taken into the field's frame: the footprint is the
+//     vertices inside its x-y extent, z_min its bottom. A_v = dx dy x (footprint vertices whose height exceeds
+//     z_min), the area of soil it overlaps seen from above. A_h = w x t, w = the box's width across the
+//     horizontal direction d, t = how deep its bottom lies below the highest vertex of the footprint grown by
+//     one vertex (the soil just ahead counts), at most the box's height. d = the horizontal velocity of the
+//     deformer's body at the box centre, else the mean horizontal part of the contact normals (toward the
+//     deformer), else none. Why the box: exact for an axis-aligned box (a blade, a plate), conservative for
+//     other shapes, and the deformation below reads the same overlap, so both halves agree.
+//   - per original point p, a vertical point (along the field's +z, friction 0, featureId ^ 0x40000000) with
+//     depth = p.depth |n.z| when useContactDepth is true (the penetration vector projected on the vertical),
+//     else 0, and E_v = E max(1, A_v / s_v);
+//   - and, when d exists and t > 0, a horizontal point (normal -d on the deformer: the soil resists the motion,
+//     friction 0, featureId ^ 0x80000000) with depth 0 (the manual: nonzero horizontal depths push in opposite
+//     directions and fail the solver) and E_h = E max(1, A_h / s_h) - the same law as the vertical one, as the
+//     manual says ("works precisely as the vertical"); a zero-depth contact resists the approach velocity
+//     with a compliance 1/E_h, so the resistance grows with the submerged frontal area, i.e. with depth;
+//   - the original point keeps its friction and gets E kDeformerSoftness (1e-3 E): very soft, it carries the
+//     friction (bounded by mu times its own small normal force - a limit of this reading).
+// s_v, s_h: setVerticalYoungsModulusAreaScaler / setHorizontalYoungsModulusAreaScaler (m^2, finite, > 0;
+// defaults 0.01, the manual's example, and 0.005, lower than the vertical as the manual's rule of thumb says).
+// E is the point's E after compression (the contact material's E x m(c)).
+//
+// Deformation (post step, after compression, before avalanches). A deformer in contact this step whose body
+// moves faster than the cut-off velocity at its box centre, or turns faster than the cut-off angular velocity
+// (setDynamicHeightFieldCutOffVelocity / ...AngularVelocity, >= 0; defaults 0.05 m/s, 0.05 rad/s), pushes
+// away the soil it overlaps: each footprint vertex with excess e = h - z_min > 0 (not a locked border vertex)
+// is lowered by e, and its volume V = e A_src goes to the first vertex outside the footprint along the
+// horizontal velocity of the body at that vertex (1/2), and along that direction turned by +-45 deg (1/4 each):
+// ahead and to the sides, a berm. A target off the grid, inside the footprint or on a locked border gives its
+// share to the other targets; with none the vertex is left. Heights only move between vertices (h_t += share
+// V / A_t), so the ledger's heightField account is unchanged: volume conserving. Compression: the pushed
+// vertex's c rises by e log2(M) / D (soil pushed away, as digging), a receiver's c falls by its rise (fresh
+// loose soil). Every moved vertex (source and targets) is armed for avalanches (armWithExtent, the life time),
+// so the berm slumps to its angle of repose. Below both cut-offs nothing is edited (heights bit-identical).
 //
 // ---------------------------------------------------------------------------------------------------------------
 // Digging (manual 25.1.1.2, 25.1.2.6-25.1.2.9, 25.1.2.12; implemented here: shovels, the cut, particles, merging)
@@ -408,8 +449,8 @@ class Terrain : public Model {
   Real getLoadAveragingTime() const { return loadAveragingTime_; }
 
   // --- dynamic height field: avalanches and the angle of repose (file comment) ------------------------------------
-  /// Turns the dynamic height field on or off (default off). On: armed vertices avalanche every step. Deformer
-  /// contacts (DynamicHeightFieldDeformer) are not built yet. Turning it off disarms every vertex.
+  /// Turns the dynamic height field on or off (default off). On: deformer contacts are rebuilt, deformers push
+  /// soil, armed vertices avalanche every step. Turning it off disarms every vertex.
   void setEnableDynamicHeightField(bool enable);
   bool getEnableDynamicHeightField() const { return dynamicHeightField_; }
   static constexpr int defaultAvalancheStepLifeTime = 100;
@@ -444,6 +485,46 @@ class Terrain : public Model {
   const TerrainAvalancheStats& getLastStepAvalancheStats() const { return avalancheStats_; }
   /// Wall-clock time of the last step's avalanche pass, s (part of getLastStepTime()).
   double getLastStepAvalancheTime() const { return lastAvalancheTime_; }
+
+  // --- dynamic height field: deformers (file comment; terrain_deform.cpp) -----------------------------------------
+  static constexpr const char* DeformerProperty = "DynamicHeightFieldDeformer";
+  static constexpr Real defaultVerticalYoungsModulusAreaScaler = 0.01;
+  static constexpr Real defaultHorizontalYoungsModulusAreaScaler = 0.005;
+  static constexpr Real defaultDynamicHeightFieldCutOffVelocity = 0.05;
+  static constexpr Real defaultDynamicHeightFieldCutOffAngularVelocity = 0.05;
+  /// Factor on the original contact point's E of a deformer contact (very soft: it carries the friction).
+  static constexpr Real kDeformerSoftness = 1e-3;
+  /// m^2, finite and > 0; otherwise std::invalid_argument, unchanged.
+  void setVerticalYoungsModulusAreaScaler(Real scale);
+  Real getVerticalYoungsModulusAreaScaler() const { return scalerV_; }
+  void setHorizontalYoungsModulusAreaScaler(Real scale);
+  Real getHorizontalYoungsModulusAreaScaler() const { return scalerH_; }
+  /// m/s and rad/s, finite and >= 0; otherwise std::invalid_argument, unchanged.
+  void setDynamicHeightFieldCutOffVelocity(Real cutOffVelocity);
+  Real getDynamicHeightFieldCutOffVelocity() const { return cutOffV_; }
+  void setDynamicHeightFieldCutOffAngularVelocity(Real cutOffAngularVelocity);
+  Real getDynamicHeightFieldCutOffAngularVelocity() const { return cutOffW_; }
+  /// E max(1, A / s_v) and E max(1, A / s_h).
+  Real computeVerticalYoungsModulus(Real E, Real area) const;
+  Real computeHorizontalYoungsModulus(Real E, Real area) const;
+  /// True when the geometry carries the bool DynamicHeightFieldDeformer property.
+  static bool isGeometryDeformer(const Geometry& g);
+  /// One deformer contact of the last step, as the listener built it.
+  struct DeformerContactInfo {
+    const Geometry* geometry = nullptr;
+    bool useContactDepth = false;
+    Real verticalArea = 0, horizontalArea = 0;  ///< A_v, A_h, m^2
+    Real youngsModulus = 0;                     ///< E of the first original point (after compression)
+    Real verticalYoungsModulus = 0, horizontalYoungsModulus = 0;
+    size_t numOriginalPoints = 0, numVerticalPoints = 0, numHorizontalPoints = 0;
+  };
+  const std::vector<DeformerContactInfo>& getLastStepDeformerContacts() const { return lastDeformerContacts_; }
+  /// What deformation did in the last step.
+  struct DeformStats {
+    size_t verticesPushed = 0;
+    Real volumePushed = 0;  ///< m^3 moved between vertices
+  };
+  const DeformStats& getLastStepDeformStats() const { return deformStats_; }
 
   // --- digging (file comment) ---------------------------------------------------------------------------------
   static constexpr const char* ShovelUpProperty = "ShovelUpProperty";
@@ -575,6 +656,15 @@ class Terrain : public Model {
   class EditBatch;
   EditBatch* editBatch_ = nullptr;   ///< the open batch of height edits while avalanches run
   double lastPreCollideTime_ = 0;  ///< s, the pre-collide listener (digging) of the last step
+  // Dynamic height field: deformers (terrain_deform.cpp).
+  struct DeformerOverlap;
+  bool deformerOverlap(const Geometry& g, DeformerOverlap& o) const;
+  void modifyDeformerContact(GeometryContact& c, int self);
+  void deformStep();
+  Real scalerV_ = defaultVerticalYoungsModulusAreaScaler, scalerH_ = defaultHorizontalYoungsModulusAreaScaler;
+  Real cutOffV_ = defaultDynamicHeightFieldCutOffVelocity, cutOffW_ = defaultDynamicHeightFieldCutOffAngularVelocity;
+  std::vector<DeformerContactInfo> deformerContacts_, lastDeformerContacts_;
+  DeformStats deformStats_;
   // Digging.
   Real minDigAngle_ = 3.14159265358979323846 / 10;
   Real mergeVelocity_ = 0.1;
