@@ -20,10 +20,8 @@ void TerrainDataInterface::setShovelGroundCuttingForce(Real force) {
 }
 
 namespace {
-bool isDeformer(const Geometry& g) {
-  const PropertyContainer& pc = g.getPropertyContainer();
-  return pc.hasPropertyBool(Terrain::DeformerProperty) && pc.getPropertyBool(Terrain::DeformerProperty);
-}
+/// A deformer carries the bool property (either value: the value is its useContactDepth, terrain.h).
+bool isDeformer(const Geometry& g) { return Terrain::isGeometryDeformer(g); }
 }  // namespace
 
 // ---- ground cutting force: the contact listener part ------------------------------------------------------------

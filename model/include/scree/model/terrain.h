@@ -563,8 +563,6 @@ class Terrain : public Model {
   const std::vector<TerrainShovelStats>& getLastStepShovelStats() const { return shovelStats_; }
   /// The shovel's entry of the last step; zeros (with `shovel` set) when it was not seen last step.
   TerrainShovelStats getShovelStats(const Geometry& shovel) const;
-  /// Name of the bool geometry property that marks a deformer (used by the ground cutting force).
-  static constexpr const char* DeformerProperty = "DynamicHeightFieldDeformer";
   // --- end shovel read-outs ----------------------------------------------------------------------------------
 
   /// Vertices loaded by contacts in the last step, and how many of them yielded.
