@@ -168,7 +168,8 @@ class GranularStage {
   template <int kFrozen>
   void solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& w, const std::vector<Real>& invM,
                  const std::vector<Real>& invI, std::vector<SolverBodyState>& bodies, Real& maxDelta) const;
-  /// solveUnit<-1> of a centred unit (the same law, with the zero angular terms of the normal row dropped).
+  /// solveUnit<kFrozen> of a centred unit (the same law, with the zero angular terms of the normal row dropped).
+  template <int kFrozen>
   void solveCentred(Unit& u, Vec3* v, Vec3* w, const Real* invM, const Real* invI, Real& maxDelta) const;
   void partition(const GranularBodySystem& ps, Real cellSize);
 
