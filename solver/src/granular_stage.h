@@ -23,6 +23,11 @@
 //                reason for slabs rather than a per-contact graph colouring, docs/solver-internals.md). Small
 //                or narrow systems (< 4 slabs or < 2048 units) run serially. Sweeps alternate forward /
 //                backward (symmetric Gauss-Seidel, as the rigid PGS).
+//                Centred pairs: the collider puts a particle pair's point on the line of centres, so the arms
+//                lie on n (r_a = -l_a n, r_b = l_b n); such units (detected to 1e-9 relative, a listener may move
+//                the point) are swept by solveCentred, the same law without the normal row's zero angular terms
+//                and with the tangents' angular parts as multiples of the basis (about half the arithmetic;
+//                docs/terrain.md, "Digging cost").
 //   integrate    x += h v for live particles; a particle whose velocity or position turns non-finite is
 //                reported by id, keeps its last position and is stopped.
 //   store        forces into the contact lists, impulses into the warm-start cache.
