@@ -54,6 +54,14 @@ struct ParticleCollider::Impl {
   std::vector<uint32_t> bucketOf;           // [size()] hash bucket per particle
   std::vector<uint32_t> bucketStart;        // [table + 1] prefix sums
   std::vector<uint32_t> sorted;             // particles by bucket, dense order within a bucket
+  // The pair search's copy of each sorted entry: its cell and centre next to its index, so a bucket is scanned
+  // contiguously (no indirection into the particle arrays for the candidates that are rejected).
+  struct Entry {
+    Vec3 x;
+    int32_t cx, cy, cz;
+    uint32_t j;
+  };
+  std::vector<Entry> entries;               // [sorted.size()]
   std::vector<std::vector<ParticleContact>> chunkOut;  // per chunk
   // Per-thread probe sphere for the geometry narrowphase.
   std::vector<std::shared_ptr<Sphere>> probeShapes;
@@ -119,6 +127,11 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
     fill.assign(m.bucketStart.begin(), m.bucketStart.end() - 1);
     for (size_t i = 0; i < n; ++i)
       if (ps.isAliveDense(i)) m.sorted[fill[m.bucketOf[i]]++] = uint32_t(i);
+    m.entries.resize(m.sorted.size());
+    for (size_t k = 0; k < m.sorted.size(); ++k) {
+      const uint32_t j = m.sorted[k];
+      m.entries[k] = {x[j], m.cx[j], m.cy[j], m.cz[j], j};
+    }
   }
 
   // ---- particle pairs ----------------------------------------------------------------------------------------
@@ -134,20 +147,35 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
       const Vec3 xi = x[i];
       const Real ri = r[i];
       const size_t firstNew = out.size();
+      // Position of the centre within its cell, in cells: a neighbour cell whose nearest point is at least one
+      // cell (>= r_i + r_j + reach) away holds no candidate, so it is not visited (about a quarter of the 27).
+      const Vec3 f = xi * m.invCell - Vec3(m.cx[i], m.cy[i], m.cz[i]);
+      Real gap2[3][3];  // [axis][offset + 1]: squared distance (cells) to the neighbour slab along the axis
+      for (int ax = 0; ax < 3; ++ax) {
+        const Real lo = std::max<Real>(f[ax], 0), hi = std::max<Real>(1 - f[ax], 0);
+        gap2[ax][0] = lo * lo;
+        gap2[ax][1] = 0;
+        gap2[ax][2] = hi * hi;
+      }
       for (int dz = -1; dz <= 1; ++dz)
         for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx)
-            m.forCell(int64_t(m.cx[i]) + dx, int64_t(m.cy[i]) + dy, int64_t(m.cz[i]) + dz, [&](uint32_t j) {
-              if (j <= i) return;
-              const Vec3 d = xi - x[j];
+          for (int dx = -1; dx <= 1; ++dx) {
+            if (gap2[0][dx + 1] + gap2[1][dy + 1] + gap2[2][dz + 1] >= 1) continue;
+            const int64_t qx = int64_t(m.cx[i]) + dx, qy = int64_t(m.cy[i]) + dy, qz = int64_t(m.cz[i]) + dz;
+            const size_t b = hashCell(qx, qy, qz) & m.tableMask;
+            for (uint32_t k = m.bucketStart[b]; k < m.bucketStart[b + 1]; ++k) {
+              const Impl::Entry& e = m.entries[k];
+              const uint32_t j = e.j;
+              if (j <= i || e.cx != qx || e.cy != qy || e.cz != qz) continue;
+              const Vec3 d = xi - e.x;
               const Real dist2 = d.squaredNorm();
               // Cheap reject first: beyond the largest margin (reach) the pair can never touch, and most
               // stencil candidates are that far; the relative speed (a square root) is read only for the rest.
               const Real far = ri + r[j] + reach;
-              if (dist2 >= far * far) return;
+              if (dist2 >= far * far) continue;
               const Real pairMargin = std::min(h * (v[i] - v[j]).norm() + margin_, reach);
               const Real lim = ri + r[j] + pairMargin;
-              if (dist2 >= lim * lim) return;
+              if (dist2 >= lim * lim) continue;
               const Real dist = std::sqrt(dist2);
               ParticleContact pc;
               pc.a = uint32_t(i);
@@ -158,7 +186,8 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
               // Midway between the two surfaces.
               pc.point = xi - pc.normal * (ri - 0.5 * pc.depth);
               out.push_back(pc);
-            });
+            }
+          }
       // Order this particle's contacts by partner so the list does not depend on the hash layout.
       std::sort(out.begin() + long(firstNew), out.end(),
                 [](const ParticleContact& p, const ParticleContact& q) { return p.b < q.b; });

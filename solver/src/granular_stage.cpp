@@ -180,10 +180,28 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     if (isPP) {
       const size_t b = size_t(c.b);
       u.rb = c.point - x[b];
-      vrel -= v[b] + w[b].cross(u.rb);
-      kn += effMass(invM[b], invInertia_[b], u.rb, u.n);
-      kt1 += effMass(invM[b], invInertia_[b], u.rb, u.t1);
-      kt2 += effMass(invM[b], invInertia_[b], u.rb, u.t2);
+      // Centred: both arms along the normal to rounding (a listener may have moved the point off the line of
+      // centres; then the general form is kept). The arms are then set exactly along n.
+      const Real la = -u.ra.dot(u.n), lb = u.rb.dot(u.n);
+      const Real tol2 = 1e-18 * (u.ra.squaredNorm() + u.rb.squaredNorm());
+      if ((u.ra + la * u.n).squaredNorm() <= tol2 && (u.rb - lb * u.n).squaredNorm() <= tol2) {
+        u.centred = true;
+        u.la = la;
+        u.lb = lb;
+        u.ra = -la * u.n;
+        u.rb = lb * u.n;
+        u.sigma = u.n.cross(u.t1).dot(u.t2) >= 0 ? 1.0 : -1.0;
+        vrel = v[a] - v[b] + u.n.cross(la * w[a] + lb * w[b]);  // w_a x r_a - w_b x r_b with the arms on n
+        const Real im = invM[a] + invM[b], rot = invInertia_[a] * la * la + invInertia_[b] * lb * lb;
+        kn = im;
+        kt1 = im + rot;
+        kt2 = im + rot;
+      } else {
+        vrel -= v[b] + w[b].cross(u.rb);
+        kn += effMass(invM[b], invInertia_[b], u.rb, u.n);
+        kt1 += effMass(invM[b], invInertia_[b], u.rb, u.t1);
+        kt2 += effMass(invM[b], invInertia_[b], u.rb, u.t2);
+      }
       kr += invInertia_[b];
       rollR = r[a] * r[b] / (r[a] + r[b]);
     } else {
@@ -415,17 +433,94 @@ void GranularStage::solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& 
   }
 }
 
+template <int kFrozen>
+void GranularStage::solveCentred(Unit& u, Vec3* v, Vec3* w, const Real* invM, const Real* invI,
+                                 Real& maxDelta) const {
+  // The arms lie on n (ra = -la n, rb = lb n): the relative normal velocity is n . (va - vb), a normal impulse
+  // turns nothing, and with n x t1 = sigma t2, n x t2 = -sigma t1 the relative velocity along t is
+  // t . (va - vb) - (la wa + lb wb) . (n x t), and an impulse d t turns a by -la d invIa (n x t) and b by
+  // -lb d invIb (n x t). Same law and order of updates as solveUnit<kFrozen>; a frozen side (the shock pass)
+  // is read but not moved, and the gains are then those of the free particle alone.
+  static_assert(kFrozen >= -1 && kFrozen <= 1);
+  const uint32_t a = u.a, b = uint32_t(u.b);
+  const Real ima = kFrozen == 0 ? 0.0 : invM[a], imb = kFrozen == 1 ? 0.0 : invM[b];
+  const Real iia = kFrozen == 0 ? 0.0 : invI[a] * u.la, iib = kFrozen == 1 ? 0.0 : invI[b] * u.lb;
+  Real kN = u.kN, kT1 = u.kT1, kT2 = u.kT2;
+  if constexpr (kFrozen >= 0) {
+    const Real im = ima + imb;  // one of them is zero
+    const Real rot = kFrozen == 0 ? iib * u.lb : iia * u.la;
+    kN = 1.0 / (im + u.eN);
+    kT1 = kT2 = 1.0 / (im + rot + u.eT);
+  }
+  // Normal.
+  {
+    const Real vn = u.n.dot(v[a] - v[b]);
+    const Real nl = std::max(u.lN + (u.rhsN - vn - u.eN * u.lN) * kN, u.loN);
+    const Real d = nl - u.lN;
+    u.lN = nl;
+    if (d != 0) {
+      const Vec3 P = d * u.n;
+      if (kFrozen != 0) v[a] += ima * P;
+      if (kFrozen != 1) v[b] -= imb * P;
+    }
+    if constexpr (kFrozen < 0) maxDelta = std::max(maxDelta, std::abs(d));
+  }
+  // Friction: scalar updates of both tangents at the same velocity, then projection onto the disc.
+  if (u.mu > 0) {
+    const Vec3 dv = v[a] - v[b];
+    const Vec3 L = u.la * w[a] + u.lb * w[b];
+    const Real vt1 = u.t1.dot(dv) - u.sigma * L.dot(u.t2);
+    const Real vt2 = u.t2.dot(dv) + u.sigma * L.dot(u.t1);
+    Real l1 = u.lT1 + (u.rhsT1 - vt1 - u.eT * u.lT1) * kT1;
+    Real l2 = u.lT2 + (u.rhsT2 - vt2 - u.eT * u.lT2) * kT2;
+    projectOntoDisc(l1, l2, frictionLimit(u.mu, u.lN));
+    const Real d1 = l1 - u.lT1, d2 = l2 - u.lT2;
+    u.lT1 = l1;
+    u.lT2 = l2;
+    if (d1 != 0 || d2 != 0) {
+      const Vec3 P = d1 * u.t1 + d2 * u.t2;
+      const Vec3 nxP = u.sigma * (d1 * u.t2 - d2 * u.t1);  // n x P
+      if (kFrozen != 0) {
+        v[a] += ima * P;
+        w[a] -= iia * nxP;
+      }
+      if (kFrozen != 1) {
+        v[b] -= imb * P;
+        w[b] -= iib * nxP;
+      }
+    }
+  }
+  // Rolling resistance, as solveUnit (left to the sweeps in the shock pass).
+  if constexpr (kFrozen < 0) {
+    if (u.rollMu > 0 && u.kR > 0) {
+      const Vec3 wr = w[a] - w[b];
+      Real l1 = u.lR1 + (-u.t1.dot(wr) - u.eT * u.lR1) * u.kR;
+      Real l2 = u.lR2 + (-u.t2.dot(wr) - u.eT * u.lR2) * u.kR;
+      projectOntoDisc(l1, l2, u.rollMu * std::max<Real>(u.lN, 0));
+      const Vec3 T = (l1 - u.lR1) * u.t1 + (l2 - u.lR2) * u.t2;
+      u.lR1 = l1;
+      u.lR2 = l2;
+      w[a] += invI[a] * T;
+      w[b] -= invI[b] * T;
+    }
+  }
+}
+
 Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies, bool backward) {
   auto& v = ps.velocities();
   auto& w = ps.angularVelocities();
   const auto& invM = ps.invMasses();
   Real maxDelta = 0;
+  auto one = [&](Unit& u, Real& md) SCREE_UNIT_INLINE {
+    if (u.centred) solveCentred<-1>(u, v.data(), w.data(), invM.data(), invInertia_.data(), md);
+    else solveUnit<-1>(u, v, w, invM, invInertia_, bodies, md);
+  };
   auto runRange = [&](uint32_t b0, uint32_t b1) {
     Real md = 0;
     if (!backward)
-      for (uint32_t k = b0; k < b1; ++k) solveUnit<-1>(units_[k], v, w, invM, invInertia_, bodies, md);
+      for (uint32_t k = b0; k < b1; ++k) one(units_[k], md);
     else
-      for (uint32_t k = b1; k-- > b0;) solveUnit<-1>(units_[k], v, w, invM, invInertia_, bodies, md);
+      for (uint32_t k = b1; k-- > b0;) one(units_[k], md);
     return md;
   };
   const int S = numSlabs_;
@@ -477,7 +572,10 @@ void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyStat
   for (int s = 0; s < sweeps; ++s)
     for (const auto& [h, code] : shockOrder_) {
       Unit& u = units_[code >> 1];
-      if (code & 1) solveUnit<1>(u, v, w, ps.invMasses(), invInertia_, bodies, unused);
+      if (u.centred) {
+        if (code & 1) solveCentred<1>(u, v.data(), w.data(), ps.invMasses().data(), invInertia_.data(), unused);
+        else solveCentred<0>(u, v.data(), w.data(), ps.invMasses().data(), invInertia_.data(), unused);
+      } else if (code & 1) solveUnit<1>(u, v, w, ps.invMasses(), invInertia_, bodies, unused);
       else solveUnit<0>(u, v, w, ps.invMasses(), invInertia_, bodies, unused);
     }
 }

@@ -23,6 +23,11 @@
 //                reason for slabs rather than a per-contact graph colouring, docs/solver-internals.md). Small
 //                or narrow systems (< 4 slabs or < 2048 units) run serially. Sweeps alternate forward /
 //                backward (symmetric Gauss-Seidel, as the rigid PGS).
+//                Centred pairs: the collider puts a particle pair's point on the line of centres, so the arms
+//                lie on n (r_a = -l_a n, r_b = l_b n); such units (detected to 1e-9 relative, a listener may move
+//                the point) are swept by solveCentred, the same law without the normal row's zero angular terms
+//                and with the tangents' angular parts as multiples of the basis (about half the arithmetic;
+//                docs/terrain.md, "Digging cost").
 //   integrate    x += h v for live particles; a particle whose velocity or position turns non-finite is
 //                reported by id, keeps its last position and is stopped.
 //   store        forces into the contact lists, impulses into the warm-start cache.
@@ -142,6 +147,11 @@ class GranularStage {
     Real rhsT1 = 0, rhsT2 = 0;  // friction targets: the surface velocity along t1, t2 (0 unless overridden)
     Real lN = 0, lT1 = 0, lT2 = 0, lR1 = 0, lR2 = 0;
     Real impact = 0;      // approach speed of a speculative stop this step, remembered for next step's bounce
+    // Centred pair (particle-particle with the point on the line of centres, as the collider makes it):
+    // ra = -la n, rb = lb n exactly, so the normal row has no angular part and n x t2 = -sigma t1,
+    // n x t1 = sigma t2; solveCentred uses these forms.
+    Real la = 0, lb = 0, sigma = 0;
+    bool centred = false;
     bool flip = false;    // a's slot is the higher one of the pair (warm-start vectors are stored for the lower)
     uint8_t solveType = FrictionModel::ITERATIVE;  // of the contact material; not ITERATIVE: DIRECT mode
   };
@@ -163,6 +173,9 @@ class GranularStage {
   template <int kFrozen>
   void solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& w, const std::vector<Real>& invM,
                  const std::vector<Real>& invI, std::vector<SolverBodyState>& bodies, Real& maxDelta) const;
+  /// solveUnit<kFrozen> of a centred unit (the same law, with the zero angular terms of the normal row dropped).
+  template <int kFrozen>
+  void solveCentred(Unit& u, Vec3* v, Vec3* w, const Real* invM, const Real* invI, Real& maxDelta) const;
   void partition(const GranularBodySystem& ps, Real cellSize);
 
   std::vector<Unit> units_;          // all units: the slabs in order, then the serial set, then DIRECT mode

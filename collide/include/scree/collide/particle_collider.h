@@ -4,7 +4,9 @@
 // margin, so every touching or speculative pair lies in the same or an adjacent cell (27-cell stencil). The
 // cells are built by a counting sort in dense order (deterministic); candidate pairs are found in parallel over
 // fixed chunks of particles, each chunk writing its own buffer, and the buffers are concatenated in chunk order,
-// so the contact list is the same for any number of threads.
+// so the contact list is the same for any number of threads. A stencil cell whose nearest point is at least one
+// cell away from the particle is skipped (no pair can reach it), and each bucket is scanned in a contiguous copy
+// of its particles' cells and centres.
 //
 // Particle pairs: analytic sphere-sphere. A pair is a (speculative) contact when its gap is below
 //   margin_ab = h |v_a - v_b| + contactMargin,
