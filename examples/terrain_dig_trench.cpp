@@ -17,7 +17,9 @@
 int main(int argc, char** argv) {
   const std::string dir = argc > 1 ? argv[1] : "";
   using namespace scree;
-  scenes::TerrainDigScene s = scenes::buildTerrainDig();
+  scenes::TerrainDigParams params;
+  params.steelBucket = true;  // the manual's set-up: a steel bucket registered as an external material
+  scenes::TerrainDigScene s = scenes::buildTerrainDig(params);
   Terrain& terrain = *s.terrain;
   const HeightField& hf = *s.field;
   std::printf("blade is a shovel: %s; particle radius %.3g m, volume %.3g m^3\n",

@@ -75,7 +75,14 @@ TerrainDigScene buildTerrainDig(const TerrainDigParams& p) {
     g->setLocalPosition(Vec3(0, side * (0.5 * W + 0.5 * t), 0.5 * H - 0.5 * t));
     s.bucket->add(g);
   }
-  for (const GeometryRef& g : s.bucket->getGeometries()) g->setMaterial(s.soil);
+  MaterialRef bucketMaterial = s.soil;
+  if (p.steelBucket) {
+    bucketMaterial = std::make_shared<Material>("steel");
+    bucketMaterial->setYoungsModulus(2e11);
+    bucketMaterial->setFrictionCoefficient(p.friction);
+    s.terrain->getDataInterface().addExternalMaterial(bucketMaterial);
+  }
+  for (const GeometryRef& g : s.bucket->getGeometries()) g->setMaterial(bucketMaterial);
   s.bucket->setMotionControl(RigidBody::KINEMATICS);
   s.bucket->setPosition(Vec3(p.startX, 0, p.startZ));
   sim.add(s.bucket);
