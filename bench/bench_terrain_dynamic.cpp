@@ -9,7 +9,10 @@
 // terrain_ms (the terrain's own stages, Terrain::getLastStepTime: pre-collide, contact listener - where the
 // deformer contacts are rebuilt - and post step, where deformation and avalanches run), avalanche_ms (its
 // avalanche pass, Terrain::getLastStepAvalancheTime; the deformation itself is not timed apart), step_ms
-// (stepForward), armed (armed vertices), pushed (vertices pushed per step). The CPU column is the thread CPU
+// (stepForward), armed (armed vertices), pushed (vertices pushed per step), points (contact points: the deformer
+// contact adds a vertical and a horizontal point per original point), and the step's stages from
+// Simulation::getStepStats: collide_ms (collision and materials), solve_ms (rows and the velocity solve), post_ms
+// (POST_STEP listeners). The CPU column is the thread CPU
 // time of the whole iteration. The goals: terrain_ms < 1 ms at n = 257 on one core; n = 513 within 1.5x
 // of n = 257 (the cost follows the blade's footprint and the armed berm, not the grid).
 #include <benchmark/benchmark.h>
@@ -30,7 +33,8 @@ void BM_dozer(benchmark::State& state) {
   p.dynamicHeightField = state.range(1) != 0;
   p.pushSeconds = kStepsPerBuild * p.dt + 1.0;  // never reaches the rest phase
   scenes::TerrainDozerScene s = scenes::buildTerrainDozer(p);
-  double stepSeconds = 0, terrainSeconds = 0, avalancheSeconds = 0, armed = 0, pushed = 0;
+  double stepSeconds = 0, terrainSeconds = 0, avalancheSeconds = 0, armed = 0, pushed = 0, points = 0;
+  double collideSeconds = 0, solveSeconds = 0, postSeconds = 0;
   for (auto _ : state) {
     if (s.stepIndex == kStepsPerBuild) {
       state.PauseTiming();
@@ -44,6 +48,11 @@ void BM_dozer(benchmark::State& state) {
     avalancheSeconds += s.terrain->getLastStepAvalancheTime();
     armed += double(s.terrain->getNumArmedVertices());
     pushed += double(s.terrain->getLastStepDeformStats().verticesPushed);
+    points += double(s.numContactPoints());
+    const StepStats& st = s.sim->getStepStats();
+    collideSeconds += st.collide;
+    solveSeconds += st.rows + st.solve;
+    postSeconds += st.post;
   }
   using C = benchmark::Counter;
   state.counters["step_ms"] = C(stepSeconds * 1e3, C::kAvgIterations);
@@ -51,6 +60,10 @@ void BM_dozer(benchmark::State& state) {
   state.counters["avalanche_ms"] = C(avalancheSeconds * 1e3, C::kAvgIterations);
   state.counters["armed"] = C(armed, C::kAvgIterations);
   state.counters["pushed"] = C(pushed, C::kAvgIterations);
+  state.counters["points"] = C(points, C::kAvgIterations);
+  state.counters["collide_ms"] = C(collideSeconds * 1e3, C::kAvgIterations);
+  state.counters["solve_ms"] = C(solveSeconds * 1e3, C::kAvgIterations);
+  state.counters["post_ms"] = C(postSeconds * 1e3, C::kAvgIterations);
 }
 BENCHMARK(BM_dozer)
     ->ArgsProduct({{257, 513}, {0, 1}})
