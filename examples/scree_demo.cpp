@@ -6,7 +6,8 @@
 // from a nozzle (demo_granular.h). Prints a one-line summary per simulated second. Then a four-wheeled vehicle on
 // TwoBodyTireModel tires drives over a bump (demo_vehicle.h), and the same vehicle drives forward, back and forward
 // over soft ground (a deformable Terrain) and prints how much deeper its ruts get per pass (demo_terrain.h), and a
-// bucket digs a trench in a Terrain, lifts and dumps the soil, and the heap merges back (demo_dig.h).
+// bucket digs a trench in a Terrain, lifts and dumps the soil, and the heap merges back (demo_dig.h), and a
+// dozer blade pushes soil into a berm that slumps toward its angle of repose (demo_dozer.h).
 //
 // Usage: scree_demo [seconds=5] [iterations=16]
 #include <cmath>
@@ -22,6 +23,7 @@
 #include "demo_granular.h"
 #include "demo_terrain.h"
 #include "demo_dig.h"
+#include "demo_dozer.h"
 
 using namespace scree;
 
@@ -165,5 +167,6 @@ int main(int argc, char** argv) {
   const bool vehicleOk = runVehicleDemo(std::min(seconds, 4.0));
   const bool terrainOk = runTerrainDemo(std::min(seconds, 5.0) / 2.5);
   const bool digOk = runDigDemo();
-  return report.ok() && vehicleOk && terrainOk && digOk ? 0 : 1;
+  const bool dozerOk = runDozerDemo();
+  return report.ok() && vehicleOk && terrainOk && digOk && dozerOk ? 0 : 1;
 }
