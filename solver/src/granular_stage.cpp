@@ -1,3 +1,4 @@
+#include <limits>
 #include "granular_stage.h"
 
 #include <algorithm>
@@ -246,6 +247,15 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     cs.rememberedImpact = ce ? ce->impact : 0.0;
     cs.adhesiveForce = p.adhF;
     cs.adhesiveOverlap = p.adhO;
+    // A glued pair (infinite adhesion: the DIRECT particle mode, docs/terrain.md "External materials and
+    // particle solve type") bonds only surfaces that touch. A speculative pair (a gap, e.g. the lattice's second
+    // neighbours at 0.24 r) is an ordinary frictionless speculative stop swept with the particles: as an
+    // infinite-adhesion equality row it would pull the gap shut to the rest overlap against the lump's bonds, and
+    // with this tiny regularisation the conflicting rows threw the lump apart.
+    // "A gap" means wider than a tenth of the smaller radius (0.2 x the reduced radius): a glued bond stretched
+    // elastically past touching (adhesive overlap 0 under tension, some 1e-7 m) stays a bond.
+    const bool gapBond = isPP && std::isinf(p.adhF) && c.depth < -0.2 * rollR;
+    if (gapBond) cs.adhesiveForce = 0;
     // Per-point overrides (ContactEventListener::particleContacts), as ContactPoint's for rigid contacts.
     cs.restitution = c.restitution >= 0 ? c.restitution : p.rest;
     const bool ownSpook = c.youngsModulus > 0 || c.damping >= 0;
@@ -258,9 +268,9 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     u.eN = nr.e;
     u.loN = nr.lo;
     u.impact = nr.impactSpeed;
-    u.solveType = p.solveType;
+    u.solveType = gapBond ? uint8_t(FrictionModel::ITERATIVE) : p.solveType;
     u.kN = 1.0 / (kn + u.eN);
-    u.mu = c.frictionCoefficient >= 0 ? c.frictionCoefficient : p.mu;
+    u.mu = gapBond ? 0.0 : c.frictionCoefficient >= 0 ? c.frictionCoefficient : p.mu;
     if (!c.surfaceVelocity.isZero(0)) {
       u.rhsT1 = c.surfaceVelocity.dot(u.t1);
       u.rhsT2 = c.surfaceVelocity.dot(u.t2);
@@ -268,7 +278,11 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     u.eT = p.eT;
     u.kT1 = 1.0 / (kt1 + u.eT);
     u.kT2 = 1.0 / (kt2 + u.eT);
-    u.rollMu = p.rolling * rollR;
+    // A glued bond (infinite adhesion, touching) does not roll either: its rolling rows are unbounded like its
+    // friction (with the material's finite rolling resistance every tensile bond - lambda_n < 0, a zero-width
+    // box - was an active-set pivot of the direct solve, some 1e4 per step).
+    u.rollMu = gapBond ? 0.0 : std::isinf(p.adhF) && p.rolling > 0 ? std::numeric_limits<Real>::infinity()
+                                                                    : p.rolling * rollR;
     u.kR = kr > 0 ? 1.0 / (kr + u.eT) : 0.0;
     if (ce && warm) {
       u.lN = std::max(ce->normal, u.loN);
