@@ -27,6 +27,20 @@ constexpr int kMaxSlabs = 64;
 #define SCREE_UNIT_INLINE
 #endif
 
+/// The rolling-resistance rows of a unit for relative angular velocity wr (a's minus b's): updates the unit's
+/// accumulated rolling impulses (disc bound rollMu * normal impulse) and returns the angular impulse on a (b gets
+/// its negative). Shared by the general and the centred unit solve.
+template <class U>
+SCREE_UNIT_INLINE inline Vec3 rollingImpulse(U& u, const Vec3& wr) {
+  Real l1 = u.lR1 + (-u.t1.dot(wr) - u.eT * u.lR1) * u.kR;
+  Real l2 = u.lR2 + (-u.t2.dot(wr) - u.eT * u.lR2) * u.kR;
+  projectOntoDisc(l1, l2, u.rollMu * std::max<Real>(u.lN, 0));
+  const Vec3 T = (l1 - u.lR1) * u.t1 + (l2 - u.lR2) * u.t2;
+  u.lR1 = l1;
+  u.lR2 = l2;
+  return T;
+}
+
 uint64_t slotKey(size_t id) { return uint64_t(uint32_t(id & 0xffffffffu)); }
 
 }  // namespace
@@ -434,12 +448,7 @@ void GranularStage::solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& 
       Vec3 wr = w[a];
       if (b >= 0) wr -= w[size_t(b)];
       else if (body) wr -= body->w;
-      Real l1 = u.lR1 + (-u.t1.dot(wr) - u.eT * u.lR1) * u.kR;
-      Real l2 = u.lR2 + (-u.t2.dot(wr) - u.eT * u.lR2) * u.kR;
-      projectOntoDisc(l1, l2, u.rollMu * std::max<Real>(u.lN, 0));
-      const Vec3 T = (l1 - u.lR1) * u.t1 + (l2 - u.lR2) * u.t2;
-      u.lR1 = l1;
-      u.lR2 = l2;
+      const Vec3 T = rollingImpulse(u, wr);
       w[a] += invI[a] * T;
       if (b >= 0) w[size_t(b)] -= invI[size_t(b)] * T;
       else if (bodyDyn) body->w -= body->invInertia * T;
@@ -508,12 +517,7 @@ void GranularStage::solveCentred(Unit& u, Vec3* v, Vec3* w, const Real* invM, co
   if constexpr (kFrozen < 0) {
     if (u.rollMu > 0 && u.kR > 0) {
       const Vec3 wr = w[a] - w[b];
-      Real l1 = u.lR1 + (-u.t1.dot(wr) - u.eT * u.lR1) * u.kR;
-      Real l2 = u.lR2 + (-u.t2.dot(wr) - u.eT * u.lR2) * u.kR;
-      projectOntoDisc(l1, l2, u.rollMu * std::max<Real>(u.lN, 0));
-      const Vec3 T = (l1 - u.lR1) * u.t1 + (l2 - u.lR2) * u.t2;
-      u.lR1 = l1;
-      u.lR2 = l2;
+      const Vec3 T = rollingImpulse(u, wr);
       w[a] += invI[a] * T;
       w[b] -= invI[b] * T;
     }
