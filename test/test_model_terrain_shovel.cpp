@@ -66,6 +66,7 @@ TEST_CASE("shovel read-out: fill = the particles the cut made, n x V; a held pla
   t->getParticleAttributes().setParticleRadius(r);
   // A kinematic plate placed 5 cm deep: the first step cuts its whole footprint into particles above it.
   RigidBodyRef plate = addBoxShovel(w, Vec3(0.2, 0.15, 0.01), Vec3(0, 0, -0.05), 0, true);
+  const Real total0 = t->getVolumeLedger().total();
   w.sim->stepForward();
   const size_t created = t->getLastStepDigStats().particlesCreated;
   const Real V = t->getParticleVolume();
@@ -107,6 +108,10 @@ TEST_CASE("shovel read-out: fill = the particles the cut made, n x V; a held pla
   CHECK(std::abs(s.particleContactForce.y()) <= 1e-3 * weight);
   // No terrain contact while it is held in the air.
   CHECK(s.terrainContactForce.norm() == 0);
+  // The soil the read-outs count is the ledger's: conserved through cut, lift and hold (the ledger invariant,
+  // 1e-9 relative as in every terrain test), and the particle account is the live particles' n V.
+  CHECK(std::abs(t->getVolumeLedger().total() - total0) <= 1e-9 * total0);
+  CHECK(t->getVolumeLedger().particles == doctest::Approx(Real(t->getParticleIds().size()) * V).epsilon(1e-12));
 }
 
 namespace {
