@@ -177,7 +177,9 @@
 //   - and, when d exists and t > 0, a horizontal point (normal -d on the deformer: the soil resists the motion,
 //     friction 0, featureId ^ 0x80000000) with depth 0 (the manual: nonzero horizontal depths push in opposite
 //     directions and fail the solver) and E_h = E max(1, A_h / s_h) - the same law as the vertical one, as the
-//     manual says ("works precisely as the vertical"); a zero-depth contact resists the approach velocity
+//     manual says ("works precisely as the vertical"; the project's design notes asked for a nonlinear f(A_h/s_h),
+//     but the manual's section names no nonlinearity and its FAQ - a lower scale gives stiffer contacts - holds
+//     for this law, so we keep the manual's); a zero-depth contact resists the approach velocity
 //     with a compliance 1/E_h, so the resistance grows with the submerged frontal area, i.e. with depth;
 //   - the original point keeps its friction and gets E kDeformerSoftness (1e-3 E): very soft, it carries the
 //     friction (bounded by mu times its own small normal force - a limit of this reading).
