@@ -19,26 +19,13 @@
 #include <vector>
 
 #include "scenes/particle_scenes.h"
+#include "bullet_timing.h"
 
 namespace {
 using namespace scree;
 using namespace scree::scenes;
 
-// Times `steps` calls of step(), returns {median, mean} in ms.
-template <class Step>
-std::pair<double, double> timeRun(int steps, Step&& step) {
-  std::vector<double> ms;
-  ms.reserve(size_t(steps));
-  for (int i = 0; i < steps; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    step();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  double mean = 0;
-  for (double x : ms) mean += x / double(ms.size());
-  std::nth_element(ms.begin(), ms.begin() + long(ms.size() / 2), ms.end());
-  return {ms[ms.size() / 2], mean};
-}
+using scree::bench::timeRun;
 
 void report(benchmark::State& state, const ParticleScene& s, std::pair<double, double> t) {
   const ParticleMetrics m = measureParticles(s);

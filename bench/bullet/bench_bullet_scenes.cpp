@@ -27,26 +27,13 @@
 #include <vector>
 
 #include "scenes/scenes.h"
+#include "bullet_timing.h"
 
 namespace {
 using namespace scree;
 using namespace scree::scenes;
 
-// Times `steps` calls of step(), returns {median, mean} in ms.
-template <class Step>
-std::pair<double, double> timeRun(int steps, Step&& step) {
-  std::vector<double> ms;
-  ms.reserve(size_t(steps));
-  for (int i = 0; i < steps; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    step();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  double mean = 0;
-  for (double x : ms) mean += x / double(ms.size());
-  std::nth_element(ms.begin(), ms.begin() + long(ms.size() / 2), ms.end());
-  return {ms[ms.size() / 2], mean};
-}
+using scree::bench::timeRun;
 
 btVector3 bt(const Vec3& v) { return btVector3(v.x(), v.y(), v.z()); }
 Vec3 sc(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
