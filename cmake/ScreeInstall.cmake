@@ -19,7 +19,7 @@ set(SCREE_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/Scree" CACHE STRING
     "Install directory of ScreeConfig.cmake, relative to the prefix")
 mark_as_advanced(SCREE_INSTALL_CMAKEDIR)
 
-set(_scree_modules scree_core scree_collide scree_solver scree_model)
+set(_scree_modules scree_core scree_collide scree_solver scree_model scree_io)
 set_target_properties(scree PROPERTIES EXPORT_NAME scree)
 
 install(TARGETS ${_scree_modules} scree
@@ -32,7 +32,7 @@ install(TARGETS ${_scree_modules} scree
 
 # Public headers: every module's include/ plus the umbrella include/ merge into one tree. OPTIONAL: a module
 # may not have public headers yet (model/).
-foreach(_dir core/include collide/include solver/include model/include include)
+foreach(_dir core/include collide/include solver/include model/include model/io/include include)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${_dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} OPTIONAL
           FILES_MATCHING PATTERN "*.h" PATTERN "*.hpp")
 endforeach()

@@ -14,7 +14,11 @@
 # (non-Debian systems with the dependencies installed by other means).
 set -euo pipefail
 
-packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libccd-dev libpng-dev doctest-dev libbenchmark-dev)
+packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libccd-dev libpng-dev zlib1g-dev doctest-dev libbenchmark-dev
+          libcli11-dev chromium python3-meshio python3-pil)
+# npm (three.js for the replay page, fetched from the npm registry at build time): Debian's package only when no
+# npm is on the PATH already (a machine with Node.js from elsewhere would conflict with Debian's npm).
+command -v npm >/dev/null 2>&1 || packages+=(npm)
 check_only=0
 for arg in "$@"; do
   case "$arg" in
