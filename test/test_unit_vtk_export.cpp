@@ -462,3 +462,112 @@ TEST_CASE("VtkExporter: bad input") {
   ex.writeFrame(*s.w.sim, 0.0);
   CHECK(ex.getNumFrames() == 1);
 }
+
+TEST_CASE("VtkExporter: every shape's surface in world coordinates (closed, outward, the closed-form volume)") {
+  TempDir dir("shapes");
+  test::TestWorld w;
+  const Real r = 0.2, h = 0.5;
+  auto place = [&](ShapeRef shape, const Vec3& p, const Quat& q) {
+    auto g = std::make_shared<Geometry>(std::move(shape));
+    g->setPosition(p);
+    g->setRotation(q);
+    w.sim->add(g);
+    return g;
+  };
+  const Quat q(Eigen::AngleAxis<Real>(0.7, Vec3(0.2, -1, 0.5).normalized()));
+  auto cyl = place(std::make_shared<Cylinder>(r, h), Vec3(1, 2, 3), q);
+  auto cap = place(std::make_shared<Capsule>(r, h), Vec3(-1, 2, 3), q);
+  std::vector<Vec3> cube;
+  for (int k = 0; k < 8; ++k) cube.push_back(Vec3(k & 1, (k >> 1) & 1, (k >> 2) & 1) * 0.4);
+  cube.push_back(Vec3(0.2, 0.2, 0.2));  // inside: not a hull vertex
+  auto hull = place(std::make_shared<Convex>(cube), Vec3(0, -2, 1), q);
+  auto plane = place(std::make_shared<Plane>(Vec3(0.1, 0.2, 1), 0.3), Vec3(0, 0, -1), q);
+  auto hf = std::make_shared<HeightField>(4, 3, 1.5, 1.0);
+  hf->setHeight(1, 1, 0.3);
+  auto field = place(hf, Vec3(3, 0, 0), q);
+  auto line = place(std::make_shared<Line>(Vec3(0, 0, 0), Vec3(0, 0, -2)), Vec3(0, 5, 1), q);
+
+  io::VtkExporter ex(dir.path.string(), "shapes");
+  ex.setTessellation(16);
+  ex.setPlaneHalfSize(7);
+  ex.writeFrame(*w.sim, 0.0);
+  ex.close();
+  const ReadBack rb = readBack(ex.getCollectionPath());
+  if (!rb.ran) return;
+  REQUIRE_MESSAGE(rb.error.empty(), rb.error);
+  const VtkFile& f = rb.files.at(ex.getFrameFiles(0)[0]);
+  const Array& pts = f.get("Points/Points");
+  std::set<size_t> used;
+
+  // Cylinder: the inscribed prism of a regular 16-gon, volume (N/2) r^2 sin(2 pi / N) h (float points: 1e-6).
+  const int N = 16;
+  const Real ngon = 0.5 * N * r * r * std::sin(2 * std::numbers::pi / N);
+  CHECK(closedVolume(f, cyl->getId(), used) == doctest::Approx(ngon * h).epsilon(1e-6));
+  for (size_t i : used) {  // every point on the cylinder's rim circles or axis ends, in its frame
+    const Vec3 l = cyl->getTransform().applyInverse(point(pts, i));
+    CHECK(std::abs(std::abs(l.y()) - 0.5 * h) <= 1e-6);
+    const Real rho = std::hypot(l.x(), l.z());
+    CHECK((rho <= 1e-6 || std::abs(rho - r) <= 1e-6));
+  }
+  // Capsule: that prism plus an inscribed sphere polyhedron (16 x 8 facets: 93.7 % of the ball, computed
+  // separately), so between prism + 90 % of the ball and the capsule's volume.
+  used.clear();
+  const Real ball = 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  const Real vc = closedVolume(f, cap->getId(), used);
+  CHECK(vc > ngon * h + 0.9 * ball);
+  CHECK(vc < std::numbers::pi * r * r * h + ball);
+  // Convex hull of a 0.4 m cube (and an inner point): exactly the cube, its 8 corners.
+  used.clear();
+  CHECK(closedVolume(f, hull->getId(), used) == doctest::Approx(0.064).epsilon(1e-6));
+  CHECK(used.size() == 8);
+  // Plane: two triangles on n . x = d (in the plane's frame), facing along n, 14 m square.
+  used.clear();
+  const Plane& pl = static_cast<const Plane&>(*plane->getShape());
+  closedVolume(f, plane->getId(), used);  // an open surface: only its points are used
+  REQUIRE(used.size() == 4);
+  for (size_t i : used)
+    CHECK(std::abs(pl.getNormal().dot(plane->getTransform().applyInverse(point(pts, i))) - pl.getDistance()) <=
+          1e-5);
+  {
+    const Array& conn = f.get("Polys/connectivity");
+    const Array& gid = f.get("CellData/geometry_id");
+    const size_t numLines = f.get("Lines/offsets").size();
+    size_t found = 0;
+    for (size_t c = 0; c < f.get("Polys/offsets").size(); ++c) {
+      if (gid.u(numLines + c) != plane->getId()) continue;
+      const Vec3 a = point(pts, size_t(conn.i64(3 * c))), b = point(pts, size_t(conn.i64(3 * c + 1))),
+                 d = point(pts, size_t(conn.i64(3 * c + 2)));
+      const Vec3 n = (b - a).cross(d - a);
+      CHECK(n.norm() == doctest::Approx(0.5 * 14 * 14 * 2).epsilon(1e-5));  // |cross| = 2 x (half the square)
+      CHECK(n.normalized().dot(plane->getRotation() * pl.getNormal()) == doctest::Approx(1).epsilon(1e-6));
+      ++found;
+    }
+    CHECK(found == 2);
+  }
+  // Height field (not a terrain): 2 triangles per cell, its vertices placed by the geometry.
+  {
+    const Array& conn = f.get("Polys/connectivity");
+    const Array& gid = f.get("CellData/geometry_id");
+    const size_t numLines = f.get("Lines/offsets").size();
+    size_t tris = 0;
+    std::set<size_t> pv;
+    for (size_t c = 0; c < f.get("Polys/offsets").size(); ++c)
+      if (gid.u(numLines + c) == field->getId()) {
+        ++tris;
+        for (int k = 0; k < 3; ++k) pv.insert(size_t(conn.i64(3 * c + k)));
+      }
+    CHECK(tris == 2 * 3 * 2);
+    REQUIRE(pv.size() == 12);
+    const size_t first = *pv.begin();  // the field's points are consecutive, x fastest
+    for (size_t j = 0; j < 3; ++j)
+      for (size_t i = 0; i < 4; ++i)
+        CHECK(isFloatOf(point(pts, first + j * 4 + i), field->getTransform().apply(hf->getVertex(i, j))));
+  }
+  // Line: one line cell (cells before the polys) between its world end points.
+  const Array& lconn = f.get("Lines/connectivity");
+  REQUIRE(lconn.size() == 2);
+  CHECK(f.get("CellData/geometry_id").u(0) == line->getId());
+  CHECK(f.get("CellData/body_id").i64(0) == -1);
+  CHECK(isFloatOf(point(pts, size_t(lconn.i64(0))), line->getTransform().apply(Vec3(0, 0, 0))));
+  CHECK(isFloatOf(point(pts, size_t(lconn.i64(1))), line->getTransform().apply(Vec3(0, 0, -2))));
+}
