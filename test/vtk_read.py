@@ -1,21 +1,28 @@
 #!/usr/bin/python3
 """Reads a VtkExporter .pvd collection and every file it lists, and prints what they hold (test_unit_vtk_export).
 
-Run with Debian's /usr/bin/python3 (python3-meshio). meshio's read() only takes the UnstructuredGrid type
-(.vtu), not PolyData (.vtp), StructuredGrid (.vts) or ImageData (.vti), so each file is decoded twice,
-independently of the C++ writer:
-  1. by meshio's own decoder of binary-appended VTK XML (meshio.vtu._vtu: _parse_raw_binary walks the appended
+Run with Debian's /usr/bin/python3 (python3-vtk9, python3-meshio: scripts/install-deps.sh). Each file is decoded
+independently of the C++ writer by up to three readers, which must agree value for value (exit 1 otherwise):
+  1. by VTK's own XML readers (the authority: what ParaView runs) - vtkXMLPolyDataReader (.vtp),
+     vtkXMLStructuredGridReader (.vts), vtkXMLImageDataReader (.vti). Any VTK error or warning while reading
+     (an ErrorEvent/WarningEvent on the reader, any text sent to VTK's output window, a reader error code) fails
+     the file. Required: without VTK the script prints "error ..." telling to run scripts/install-deps.sh;
+  2. by meshio's own decoder of binary-appended VTK XML (meshio.vtu._vtu: _parse_raw_binary walks the appended
      blocks by their UInt64 byte counts and matches each to the DataArray whose offset it starts at;
      VtuReader.read_data decodes one array) - skipped, with "meshio no" printed, when meshio is not installed;
-  2. by this script: xml.etree for the XML, struct for the appended blocks, checking that the blocks tile the
+     (meshio's read() only takes UnstructuredGrid, .vtu, not PolyData, StructuredGrid or ImageData)
+  3. by this script: xml.etree for the XML, struct for the appended blocks, checking that the blocks tile the
      appended section exactly (each array starts where the previous ended, nothing after the last).
-The two must agree value for value (exit 1 otherwise). Output, one record per line:
+Output, one record per line:
+  vtk <VTK version>
   meshio yes|no
   dataset <timestep> <part> <file>                  (the .pvd entries, in order)
   file <file> <VTKFile type>
   attr <name> <value>                               (attributes of the dataset element, e.g. WholeExtent)
   piece <name> <value>                              (attributes of the Piece)
   array <section> <name> <type> <components> <count> <values...>   (floats as repr: exact doubles)
+  voxel <i> <j> <k> <x> <y> <z>     (ImageData: each cell's centre, VTK's index-to-physical map of (i+.5, j+.5, k+.5))
+  reader <VTK reader class> meshio|- struct      (the decoders that agreed on this file)
   end
 """
 import os
@@ -33,6 +40,16 @@ try:
     HAVE_MESHIO = True
 except ImportError:
     HAVE_MESHIO = False
+
+try:
+    import numpy as np
+    from vtkmodules.util.misc import calldata_type
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkCommonCore import VTK_STRING, vtkOutputWindow, vtkStringOutputWindow, vtkVersion
+    from vtkmodules.vtkIOXML import vtkXMLImageDataReader, vtkXMLPolyDataReader, vtkXMLStructuredGridReader
+    VTK_IMPORT_ERROR = None
+except ImportError as e:
+    VTK_IMPORT_ERROR = str(e)
 
 
 def fail(msg):
@@ -95,6 +112,114 @@ def decode_meshio(path):
     return [np.asarray(reader.read_data(a)).reshape(-1).tolist() for a in root.findall(".//DataArray")]
 
 
+def vtk_reader_class(kind):
+    return {"PolyData": vtkXMLPolyDataReader, "StructuredGrid": vtkXMLStructuredGridReader,
+            "ImageData": vtkXMLImageDataReader}[kind]
+
+
+def read_vtk(path, kind):
+    """The dataset as VTK's XML reader for `kind` reads it; any error or warning on the way fails."""
+    log = vtkStringOutputWindow()  # everything VTK would print (parser, executive, reader) lands here
+    vtkOutputWindow.SetInstance(log)
+    reader = vtk_reader_class(kind)()
+    messages = []
+
+    @calldata_type(VTK_STRING)
+    def on_message(obj, event, text):
+        messages.append(f"{event}: {text}")
+
+    reader.AddObserver("ErrorEvent", on_message)
+    reader.AddObserver("WarningEvent", on_message)
+    reader.SetFileName(path)
+    reader.Update()
+    if messages or log.GetOutput().strip() or reader.GetErrorCode() != 0:
+        fail(f"{path}: {reader.GetClassName()} reported errors (error code {reader.GetErrorCode()}): "
+             + " | ".join(messages + [log.GetOutput().strip()]).replace("\n", " "))
+    out = reader.GetOutput()
+    if out is None or out.GetClassName() != "vtk" + kind:
+        fail(f"{path}: {reader.GetClassName()} gave no vtk{kind}")
+    return reader, out
+
+
+def check_vtk(path, kind, root, arrays, values):
+    """Checks that VTK's reader gives every array of the file (values, type, components), the piece's sizes and
+    the dataset attributes exactly as the struct decoder; returns the voxel-centre lines for ImageData."""
+    reader, out = read_vtk(path, kind)
+    name = reader.GetClassName()
+    ds = root.find(kind)
+    piece = ds.find("Piece")
+
+    def same(what, got, want):
+        if len(got) != len(want) or any(x != y for x, y in zip(got, want)):
+            fail(f"{path}: {name} and struct disagree on {what}: {list(got)[:12]} vs {list(want)[:12]}")
+
+    def data_array(section, a, vtk_array):
+        if vtk_array is None:
+            fail(f"{path}: {name} has no {section} array {a.get('Name')}")
+        arr = vtk_to_numpy(vtk_array)
+        if arr.dtype != np.dtype(FORMATS[a.get("type")]):
+            fail(f"{path}: {name} reads {section}/{a.get('Name')} as {arr.dtype}, the file says {a.get('type')}")
+        if vtk_array.GetNumberOfComponents() != int(a.get("NumberOfComponents", "1")):
+            fail(f"{path}: {name}: {section}/{a.get('Name')} has {vtk_array.GetNumberOfComponents()} components")
+        same(section + "/" + a.get("Name"), arr.reshape(-1).tolist(), values[id(a)])
+
+    # Sizes.
+    npts = out.GetNumberOfPoints()
+    if kind == "PolyData":
+        if npts != int(piece.get("NumberOfPoints")):
+            fail(f"{path}: {name} reads {npts} points, the piece says {piece.get('NumberOfPoints')}")
+        for tag, cells in (("Verts", out.GetVerts()), ("Lines", out.GetLines()), ("Strips", out.GetStrips()),
+                           ("Polys", out.GetPolys())):
+            n = int(piece.get("NumberOf" + tag, "0"))
+            if cells.GetNumberOfCells() != n:
+                fail(f"{path}: {name} reads {cells.GetNumberOfCells()} {tag}, the piece says {n}")
+            section = piece.find(tag)
+            if section is None:
+                continue
+            for a in section.findall("DataArray"):
+                if a.get("Name") == "connectivity":
+                    same(tag + "/connectivity", vtk_to_numpy(cells.GetConnectivityArray()).tolist(), values[id(a)])
+                elif a.get("Name") == "offsets":  # VTK's offsets start with a 0 that the file leaves out
+                    off = vtk_to_numpy(cells.GetOffsetsArray()).tolist()
+                    if not off or off[0] != 0:
+                        fail(f"{path}: {name}: {tag} offsets do not start at 0")
+                    same(tag + "/offsets", off[1:], values[id(a)])
+                else:
+                    fail(f"{path}: unexpected {tag} array {a.get('Name')}")
+    else:
+        want = [int(v) for v in ds.get("WholeExtent").split()]
+        same("WholeExtent", list(out.GetExtent()), want)
+        if npts != (want[1] - want[0] + 1) * (want[3] - want[2] + 1) * (want[5] - want[4] + 1):
+            fail(f"{path}: {name} reads {npts} points for extent {want}")
+    # Points (ImageData has none: they follow from Origin/Spacing/Direction).
+    pts = piece.find("Points")
+    if pts is not None:
+        data_array("Points", pts.find("DataArray"), out.GetPoints().GetData() if out.GetPoints() else None)
+    # Point and cell data: the same arrays, no more.
+    for section, data in (("PointData", out.GetPointData()), ("CellData", out.GetCellData())):
+        elem = piece.find(section)
+        listed = elem.findall("DataArray") if elem is not None else []
+        if data.GetNumberOfArrays() != len(listed):
+            fail(f"{path}: {name} reads {data.GetNumberOfArrays()} {section} arrays, the file has {len(listed)}")
+        for a in listed:
+            data_array(section, a, data.GetAbstractArray(a.get("Name")))
+    voxels = []
+    if kind == "ImageData":
+        same("Origin", list(out.GetOrigin()), [float(v) for v in ds.get("Origin").split()])
+        same("Spacing", list(out.GetSpacing()), [float(v) for v in ds.get("Spacing").split()])
+        m = out.GetDirectionMatrix()
+        same("Direction", [m.GetElement(r, c) for r in range(3) for c in range(3)],
+             [float(v) for v in ds.get("Direction").split()])
+        e = out.GetExtent()
+        for k in range(e[4], e[5]):
+            for j in range(e[2], e[3]):
+                for i in range(e[0], e[1]):
+                    x = [0.0, 0.0, 0.0]
+                    out.TransformContinuousIndexToPhysicalPoint(i + 0.5, j + 0.5, k + 0.5, x)
+                    voxels.append(f"voxel {i} {j} {k} " + " ".join(repr(float(c)) for c in x))
+    return name, voxels
+
+
 def fmt_value(v):
     return repr(float(v)) if isinstance(v, float) else str(int(v))
 
@@ -105,6 +230,7 @@ def read_file(path, name):
     root, data = split_file(raw, path)
     kind = root.get("type")
     arrays, values = decode_struct(root, data, path)
+    vtk_name, voxels = check_vtk(path, kind, root, arrays, values)
     if HAVE_MESHIO:
         via_meshio = decode_meshio(path)
         if len(via_meshio) != len(arrays):
@@ -125,11 +251,18 @@ def read_file(path, name):
             vals = values[id(a)]
             print("array", section.tag, a.get("Name", "-"), a.get("type"), a.get("NumberOfComponents", "1"),
                   len(vals), " ".join(fmt_value(v) for v in vals))
+    for line in voxels:
+        print(line)
+    print("reader", vtk_name, "meshio" if HAVE_MESHIO else "-", "struct")
     print("end")
 
 
 def main():
     pvd = sys.argv[1]
+    if VTK_IMPORT_ERROR is not None:
+        fail(f"{sys.executable} cannot import VTK's Python bindings ({VTK_IMPORT_ERROR}): the ParaView export is "
+             "validated by VTK's own XML readers; run scripts/install-deps.sh (Debian package python3-vtk9)")
+    print("vtk", vtkVersion.GetVTKVersion())
     print("meshio", "yes" if HAVE_MESHIO else "no")
     root = ET.parse(pvd).getroot()
     if root.get("type") != "Collection":
