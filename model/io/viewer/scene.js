@@ -50,20 +50,49 @@ const ScreeScene = (() => {
     return g;
   }
 
+  // A unit icosphere with shared vertices (three's IcosahedronGeometry repeats them per face: 60 vertices for
+  // 20 faces), so each particle costs 12 vertex-shader runs at detail 0 (42 at detail 1), and the normals are
+  // the sphere's (smooth shading).
+  function indexedSphere(detail) {
+    const src = new THREE.IcosahedronGeometry(1, detail).attributes.position.array;
+    const key = new Map(), pos = [], idx = [];
+    for (let v = 0; v < src.length / 3; ++v) {
+      const x = src[3 * v], y = src[3 * v + 1], z = src[3 * v + 2];
+      const k = `${Math.round(x * 1e4)},${Math.round(y * 1e4)},${Math.round(z * 1e4)}`;
+      if (!key.has(k)) { key.set(k, pos.length / 3); pos.push(x, y, z); }
+      idx.push(key.get(k));
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute("position", new THREE.Float32BufferAttribute(pos, 3));
+    g.setAttribute("normal", new THREE.Float32BufferAttribute(pos, 3));
+    g.setIndex(idx);
+    return g;
+  }
+
   class Scene {
     constructor(rec, container) {
       this.rec = rec;
-      const renderer = (this.renderer = new THREE.WebGLRenderer({ antialias: true }));
+      // Multisampling costs little on a GPU but much in software GL; ?aa=0 / ?aa=1 in the page's URL overrides
+      // the default (on below 3000 particles).
+      const aa = new URLSearchParams(window.location.search).get("aa");
+      const antialias = aa !== null ? aa === "1" : rec.maxParticles < 3000;
+      const renderer = (this.renderer = new THREE.WebGLRenderer({ antialias }));
       renderer.setPixelRatio(window.devicePixelRatio || 1);
       renderer.setSize(container.clientWidth, container.clientHeight);
       container.appendChild(renderer.domElement);
+      const gl = renderer.getContext();
+      const info = gl.getExtension("WEBGL_debug_renderer_info");
+      this.glRenderer = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+      this.softwareGL = /swiftshader|llvmpipe|softpipe|software/i.test(this.glRenderer);
       const scene = (this.scene = new THREE.Scene());
       scene.background = new THREE.Color(0x1e2228);
       const camera = (this.camera = new THREE.PerspectiveCamera(40, container.clientWidth / container.clientHeight, 0.01, 1000));
       camera.up.set(0, 0, 1);
-      scene.add(new THREE.HemisphereLight(0xdfe8ff, 0x4a4038, 1.2));
-      const sun = new THREE.DirectionalLight(0xffffff, 1.8);
-      sun.position.set(3, -5, 8);
+      // three's lights are physical (a Lambert surface returns albedo * irradiance / pi): a sky light and a
+      // sun from behind the default camera's shoulder, so the top, front and side faces of a box differ.
+      scene.add(new THREE.HemisphereLight(0xdfe8ff, 0x6a6058, 2.0));
+      const sun = new THREE.DirectionalLight(0xffffff, 2.5);
+      sun.position.set(2, -5, 6);
       scene.add(sun);
 
       this.materials = rec.scene.materials.map((m) => new THREE.MeshLambertMaterial({ color: srgb(m.rgb) }));
@@ -132,6 +161,11 @@ const ScreeScene = (() => {
             break;
         }
         if (!obj) continue;
+        if (g.shape === "box" || g.shape === "convex") {
+          // Dark edges, so stacked boxes of one material read as separate boxes.
+          const edgeColour = mat.color.clone().multiplyScalar(0.35);
+          obj.add(new THREE.LineSegments(new THREE.EdgesGeometry(obj.geometry), new THREE.LineBasicMaterial({ color: edgeColour })));
+        }
         if (g.shape !== "plane") {
           obj.position.set(...g.position);
           obj.quaternion.set(...g.rotation);
@@ -153,19 +187,67 @@ const ScreeScene = (() => {
       return { hf, mesh, geo };
     }
 
+    // Two ways to draw particles, the same colours and sizes:
+    //  "mesh"   one InstancedMesh of icospheres (per-instance matrix = radius scale + translation, per-instance
+    //           colour): the default, cheap on any GPU;
+    //  "points" sphere sprites (one vertex per particle, a shaded disc of the particle's projected radius):
+    //           the default under software GL with more than 2000 particles, where instanced draws cost about
+    //           25 us per instance (SwiftShader, measured: 10,000 instances = 250 ms a frame) and sprites
+    //           cost one vertex each. ?particles=mesh or ?particles=points in the page's URL overrides.
     buildParticles() {
       const cap = Math.max(1, this.rec.maxParticles);
-      // 20 triangles per particle when there are many (the page must play 10,000 at 30 frames/s), 80 otherwise.
-      const sphere = new THREE.IcosahedronGeometry(1, cap > 3000 ? 0 : 1);
-      const mat = new THREE.MeshLambertMaterial({ color: 0xffffff });
-      const mesh = (this.particles = new THREE.InstancedMesh(sphere, mat, cap));
-      mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
-      mesh.instanceColor = new THREE.InstancedBufferAttribute(new Float32Array(3 * cap), 3);
-      mesh.instanceColor.setUsage(THREE.DynamicDrawUsage);
-      mesh.count = 0;
-      mesh.frustumCulled = false;
       this.particleMaterialColours = this.rec.scene.particleMaterials.map((m) => srgb(m.rgb));
-      this.scene.add(mesh);
+      const asked = new URLSearchParams(window.location.search).get("particles");
+      this.particleMode = asked === "mesh" || asked === "points" ? asked : this.softwareGL && cap > 2000 ? "points" : "mesh";
+      this.particleColours = new Float32Array(3 * cap);
+      if (this.particleMode === "points") {
+        const g = new THREE.BufferGeometry();
+        this.pointPositions = new THREE.BufferAttribute(new Float32Array(3 * cap), 3).setUsage(THREE.DynamicDrawUsage);
+        this.pointRadii = new THREE.BufferAttribute(new Float32Array(cap), 1).setUsage(THREE.DynamicDrawUsage);
+        this.pointColours = new THREE.BufferAttribute(this.particleColours, 3).setUsage(THREE.DynamicDrawUsage);
+        g.setAttribute("position", this.pointPositions);
+        g.setAttribute("radius", this.pointRadii);
+        g.setAttribute("colour", this.pointColours);
+        g.setDrawRange(0, 0);
+        const mat = new THREE.ShaderMaterial({
+          uniforms: { viewportHeight: { value: 600 } },
+          vertexShader: `
+            attribute float radius;
+            attribute vec3 colour;
+            uniform float viewportHeight;
+            varying vec3 vColour;
+            void main() {
+              vec4 mv = modelViewMatrix * vec4(position, 1.0);
+              gl_Position = projectionMatrix * mv;
+              // Diameter in pixels of a sphere of this radius at this depth (perspective camera).
+              gl_PointSize = max(1.0, 2.0 * radius * projectionMatrix[1][1] * 0.5 * viewportHeight / -mv.z);
+              vColour = colour;
+            }`,
+          fragmentShader: `
+            varying vec3 vColour;
+            void main() {
+              vec2 d = 2.0 * gl_PointCoord - 1.0;
+              float r2 = dot(d, d);
+              if (r2 > 1.0) discard;
+              // The sphere's normal in view space (y of gl_PointCoord points down); light from the upper left
+              // front and a sky term, close to the meshes' Lambert shading.
+              vec3 n = vec3(d.x, -d.y, sqrt(1.0 - r2));
+              float sun = max(dot(n, normalize(vec3(-0.3, 0.6, 0.75))), 0.0);
+              gl_FragColor = vec4(vColour * (0.35 + 0.75 * sun), 1.0);
+              #include <colorspace_fragment>
+            }`,
+        });
+        this.particles = new THREE.Points(g, mat);
+      } else {
+        // 20 triangles per particle when there are many, 80 otherwise.
+        const mesh = (this.particles = new THREE.InstancedMesh(indexedSphere(cap > 3000 ? 0 : 1), new THREE.MeshLambertMaterial({ color: 0xffffff }), cap));
+        mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+        mesh.instanceColor = new THREE.InstancedBufferAttribute(this.particleColours, 3);
+        mesh.instanceColor.setUsage(THREE.DynamicDrawUsage);
+        mesh.count = 0;
+      }
+      this.particles.frustumCulled = false;
+      this.scene.add(this.particles);
     }
 
     buildContacts() {
@@ -221,16 +303,7 @@ const ScreeScene = (() => {
         g.position.set(p[7 * b], p[7 * b + 1], p[7 * b + 2]);
         g.quaternion.set(p[7 * b + 3], p[7 * b + 4], p[7 * b + 5], p[7 * b + 6]);
       });
-      // Particles: the instance matrix is a uniform scale by the radius and a translation, written directly.
-      const n = f.count, m = this.particles.instanceMatrix.array, col = this.particles.instanceColor.array;
-      const x = f.positions, rad = f.radii;
-      for (let i = 0; i < n; ++i) {
-        const r = rad[i], o = 16 * i;
-        m[o] = r; m[o + 1] = 0; m[o + 2] = 0; m[o + 3] = 0;
-        m[o + 4] = 0; m[o + 5] = r; m[o + 6] = 0; m[o + 7] = 0;
-        m[o + 8] = 0; m[o + 9] = 0; m[o + 10] = r; m[o + 11] = 0;
-        m[o + 12] = x[3 * i]; m[o + 13] = x[3 * i + 1]; m[o + 14] = x[3 * i + 2]; m[o + 15] = 1;
-      }
+      const n = f.count, x = f.positions, rad = f.radii, col = this.particleColours;
       if (this.colourBy === "speed") {
         const scale = this.rec.maxSpeed > 0 ? 255 / this.rec.maxSpeed : 0, s = f.speeds;
         for (let i = 0; i < n; ++i) {
@@ -244,9 +317,25 @@ const ScreeScene = (() => {
           col[3 * i] = c.r; col[3 * i + 1] = c.g; col[3 * i + 2] = c.b;
         }
       }
-      this.particles.count = n;
-      this.particles.instanceMatrix.needsUpdate = true;
-      this.particles.instanceColor.needsUpdate = true;
+      if (this.particleMode === "points") {
+        this.pointPositions.array.set(x.subarray(0, 3 * n));
+        this.pointRadii.array.set(rad.subarray(0, n));
+        this.pointPositions.needsUpdate = this.pointRadii.needsUpdate = this.pointColours.needsUpdate = true;
+        this.particles.geometry.setDrawRange(0, n);
+      } else {
+        // The instance matrix is a uniform scale by the radius and a translation, written directly.
+        const m = this.particles.instanceMatrix.array;
+        for (let i = 0; i < n; ++i) {
+          const r = rad[i], o = 16 * i;
+          m[o] = r; m[o + 1] = 0; m[o + 2] = 0; m[o + 3] = 0;
+          m[o + 4] = 0; m[o + 5] = r; m[o + 6] = 0; m[o + 7] = 0;
+          m[o + 8] = 0; m[o + 9] = 0; m[o + 10] = r; m[o + 11] = 0;
+          m[o + 12] = x[3 * i]; m[o + 13] = x[3 * i + 1]; m[o + 14] = x[3 * i + 2]; m[o + 15] = 1;
+        }
+        this.particles.count = n;
+        this.particles.instanceMatrix.needsUpdate = true;
+        this.particles.instanceColor.needsUpdate = true;
+      }
       // Contacts: points only (the normal force is in the file for tools that want it).
       const c = f.contacts, nc = c.length / 7, cp = this.contacts.geometry.attributes.position;
       for (let i = 0; i < nc; ++i) {
@@ -281,7 +370,11 @@ const ScreeScene = (() => {
       this.renderer.setSize(w, h);
     }
 
-    render() { this.renderer.render(this.scene, this.camera); }
+    render() {
+      if (this.particleMode === "points")
+        this.particles.material.uniforms.viewportHeight.value = this.renderer.getDrawingBufferSize(new THREE.Vector2()).y;
+      this.renderer.render(this.scene, this.camera);
+    }
 
     // CSS-pixel position in the canvas of a world point, as the camera shows it now.
     project(x, y, z) {

@@ -95,7 +95,8 @@
     const s = new ScreeScene.Scene(rec, view);
     const n = rec.frames.length;
     $("scene-name").textContent = rec.scene.name || title;
-    $("counts").textContent = `${rec.scene.bodies.length} bodies, up to ${rec.maxParticles} particles, ${n} frames`;
+    $("counts").textContent = `${rec.scene.bodies.length} bodies, up to ${rec.maxParticles} particles ` +
+      `(drawn as ${s.particleMode === "points" ? "sprites" : "meshes"}), ${n} frames`;
     $("frames").textContent = n - 1;
     $("speed-max").textContent = rec.maxSpeed.toPrecision(3);
     const lg = $("legend").getContext("2d");
@@ -178,6 +179,7 @@
     window.scree = {
       ready: true,
       recording: rec,
+      view: s,  // the ScreeScene.Scene (three.js objects), for experiments from the console
       stats,
       timings: { base64Ms, parseMs: rec.parseMs, decodeMs: rec.decodeMs, bytes: bytes.length },
       get frame() { return state.frame; },
