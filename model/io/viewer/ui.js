@@ -2,7 +2,8 @@
 // wheel: zoom; z stays up), play/pause, playback speed, the time scrubber, the frame counter and time.
 // Playback follows the recording's clock: at speed 1 a recording with a frame interval of 1/30 s shows 30
 // frames per second of wall time, whatever the display's refresh rate. A frame the renderer could not keep
-// up with is skipped, not slowed down. Test and measurement hooks: window.scree (see the end of the file).
+// up with is skipped, not slowed down (up to stalls of 0.25 s). Test and measurement hooks: window.scree
+// (see the end of the file).
 "use strict";
 
 (() => {
@@ -147,13 +148,17 @@
     const keep = (a, v) => { a.push(v); if (a.length > 600) a.shift(); };
     let lastRaf = null;
 
-    function tick(now) {
+    function tick() {
+      // performance.now(), not the callback's timestamp: the first animation frame after a long load can
+      // carry a begin-frame time from before it, which would jump the clock ahead. A stall of more than
+      // 0.25 s advances the recording by 0.25 s (playback slows down rather than jumping).
+      const now = performance.now();
       if (lastRaf !== null) keep(stats.intervals, now - lastRaf);
       lastRaf = now;
-      const w0 = performance.now();
+      const w0 = now;
       if (state.playing) {
         if (state.lastWall !== null) {
-          state.clock += ((now - state.lastWall) / 1000) * state.rate;
+          state.clock += (Math.min(250, now - state.lastWall) / 1000) * state.rate;
           if (state.clock > duration + rec.scene.frameInterval) state.clock = 0;  // loop
         }
         state.lastWall = now;
@@ -183,6 +188,7 @@
       stats,
       timings: { base64Ms, parseMs: rec.parseMs, decodeMs: rec.decodeMs, bytes: bytes.length },
       get frame() { return state.frame; },
+      get clock() { return state.clock; },  // recording time played (s), from the first frame
       play() { setPlaying(true); },
       pause() { setPlaying(false); },
       project: (x, y, z) => s.project(x, y, z),
