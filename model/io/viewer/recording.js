@@ -147,12 +147,14 @@ const ScreeRecording = (() => {
     const pos = r.words(3 * n, "particle positions");
     const speed = r.words(n, "particle speeds");
     if (delta) {
-      const pi = prev.ids, pp = prev.posBits, ps = prev.speedBits;
-      for (let i = 0; i < n; ++i) ids[i] ^= pi[i];
+      // A delta frame has the previous frame's ids (stored as zero XOR): they are shared, not copied.
+      for (let i = 0; i < n; ++i)
+        if (ids[i] !== 0) throw new FormatError(`${r.what}: a delta frame changes particle id ${i} (a key frame must)`);
+      const pp = prev.posBits, ps = prev.speedBits;
       for (let i = 0; i < 3 * n; ++i) pos[i] ^= pp[i];
       for (let i = 0; i < n; ++i) speed[i] ^= ps[i];
     }
-    f.ids = ids;
+    f.ids = delta ? prev.ids : ids;
     f.posBits = pos;
     f.speedBits = speed;
     f.positions = new Float32Array(pos.buffer);
