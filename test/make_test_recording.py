@@ -120,6 +120,32 @@ def header(major=MAJOR, minor=MINOR):
     return b"SCREEREC" + struct.pack("<HHI", major, minor, 0)
 
 
+TERRAIN_NX, TERRAIN_NY, TERRAIN_ELEM = 9, 7, 0.25
+
+
+def terrain_initial():
+    return [0.05 * math.sin(i) for i in range(TERRAIN_NX * TERRAIN_NY)]
+
+
+def terrain_rects(f):
+    """The tower10 terrain's changed rectangles at frame f: (i0, j0, w, h, heights)."""
+    if f > 0 and f % 5 == 0:
+        i0, j0, w, h = (f // 5) % (TERRAIN_NX - 2), 1, 2, 3
+        return [(i0, j0, w, h, [0.1 + 0.01 * f + 0.02 * q for q in range(w * h)])]
+    return []
+
+
+def terrain_heights(frame):
+    """The tower10 terrain's heights (float32 values) after the rectangles of frames 1..frame."""
+    h = terrain_initial()
+    for f in range(1, frame + 1):
+        for i0, j0, w, hh, values in terrain_rects(f):
+            for j in range(hh):
+                for i in range(w):
+                    h[(j0 + j) * TERRAIN_NX + i0 + i] = values[j * w + i]
+    return list(struct.unpack("<%df" % len(h), struct.pack("<%df" % len(h), *h)))
+
+
 def tower_box_z(k, frame):
     """Centre height of box k (0 = bottom) at a frame: 2 cm above rest, falling to rest in 10 frames."""
     rest = TOWER_BOX_HALF * (2 * k + 1)
@@ -146,8 +172,7 @@ def tower10(frames):
     for name, motion, g, _ in others:
         bodies.append(body(name, motion, g))
     out = header() + scene_chunk("tower10", materials, bodies, [("sand", (220, 200, 120)), ("gravel", (150, 150, 160))])
-    nx, ny, elem = 9, 7, 0.25
-    out += hfld_chunk(nx, ny, elem, (-1.0, -6.0, 0.0), (0, 0, 0, 1), [0.05 * math.sin(i) for i in range(nx * ny)])
+    out += hfld_chunk(TERRAIN_NX, TERRAIN_NY, TERRAIN_ELEM, (-1.0, -6.0, 0.0), (0, 0, 0, 1), terrain_initial())
     out += chunk(b"XTRA", b"a chunk from a newer minor version: skipped")
     enc = FrameEncoder()
     for f in range(frames):
@@ -171,10 +196,7 @@ def tower10(frames):
         for x, y, z in base:
             pos += [x, y, max(z - z_drop, radii[0])]
         speeds = [9.81 * fall_t if z_drop < 1.0 else 0.0] * len(ids)
-        rects = []
-        if f > 0 and f % 5 == 0:
-            i0, j0, w, h = (f // 5) % (nx - 2), 1, 2, 3
-            rects.append((i0, j0, w, h, [0.1 + 0.01 * f + 0.02 * q for q in range(w * h)]))
+        rects = terrain_rects(f)
         contacts = [(0, 0, TOWER_BOX_HALF * 2 * k, 0, 0, 1, 9.81 * 216 * (TOWER_N - k)) for k in range(TOWER_N)]
         out += enc.frame(f, t, poses, ids, pos, speeds, radii, mats, [rects], contacts)
     out += chunk(b"ENDR", struct.pack("<I", frames))

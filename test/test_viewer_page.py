@@ -13,8 +13,10 @@
    pixels at the projected centres of the bottom, middle and top boxes have the boxes' orange hue, and the
    pixels 1 m above the top box and 2 m beside the tower (projected the same way) do not; the console has no
    errors and no exception was thrown.
-3. With ?particles=points (the sprite renderer) the page runs without console errors.
-4. Corrupted files (a flipped byte, a newer major version, a truncated file) each show their message in the
+3. The scrubber shows the frame asked for, and the terrain's heights (rectangles applied forward and
+   replayed back) are the recorded ones.
+4. With ?particles=points (the sprite renderer) the page runs without console errors.
+5. Corrupted files (a flipped byte, a newer major version, a truncated file) each show their message in the
    page (#error) instead of a scene.
 With --perf: writes a PARTICLES x FRAMES recording of moving particles, loads it and prints the decode time
 and the frame rate (requestAnimationFrame intervals while playing) instead of the checks.
@@ -284,6 +286,19 @@ def run_checks(args, browser):
     check(px is not None and not is_orange(px), f"2 m beside the tower ({u}, {v}) is not the boxes' colour: {px}")
     errs = page.console_errors()
     check(not errs, "no console errors or exceptions" + ("".join("\n      " + e for e in errs)))
+
+    # The scrubber: moving it shows that frame, and the terrain mesh then holds the heights the generator
+    # wrote up to that frame (float32, exact), forward (rectangles applied in order) and back (replayed from
+    # the initial heights).
+    for target in (37, 12, 55):
+        got = page.eval(f"""(() => {{ const s = document.getElementById('scrub'); s.value = {target};
+            s.dispatchEvent(new Event('input')); window.scree.renderNow();
+            const z = Array.from(window.scree.view.terrains[0].geo.attributes.position.array).filter((_, i) => i % 3 == 2);
+            return [window.scree.frame, z]; }})()""")
+        want = mtr.terrain_heights(target)
+        check(got[0] == target and got[1] == want,
+              f"scrubbing to frame {target}: the terrain holds the recorded heights (frame {got[0]}, "
+              f"{sum(a != b for a, b in zip(got[1], want))} of {len(want)} vertices differ)")
 
     # The other particle renderer (sphere sprites, the software-GL default above 2000 particles): its shaders
     # compile and it draws the same frame without errors.
