@@ -364,6 +364,28 @@ const ScreeScene = (() => {
       return box;
     }
 
+    // What the camera frames at first: the moving bodies and the particles of the first and the last frame,
+    // and the height fields; static bodies only when nothing else is there (a large ground would otherwise
+    // shrink a pile or a tower to a few pixels).
+    viewBounds() {
+      const box = new THREE.Box3(), v = new THREE.Vector3();
+      const last = this.rec.frames.length - 1;
+      for (const k of [last, 0]) {
+        this.showFrame(k, false);
+        this.scene.updateMatrixWorld(true);
+        this.rec.scene.bodies.forEach((b, i) => {
+          if (b.motion === 0) return;
+          this.bodies[i].traverse((o) => {
+            if (!o.userData.unbounded && (o.isMesh || o.isLine)) box.expandByObject(o);
+          });
+        });
+        const f = this.rec.frames[k];
+        for (let i = 0; i < f.count; ++i) box.expandByPoint(v.set(f.positions[3 * i], f.positions[3 * i + 1], f.positions[3 * i + 2]));
+      }
+      for (const t of this.terrains) box.expandByObject(t.mesh);
+      return box.isEmpty() ? this.bounds(0) : box;
+    }
+
     resize(w, h) {
       this.camera.aspect = w / h;
       this.camera.updateProjectionMatrix();

@@ -122,8 +122,8 @@
       return lo;
     };
     const orbit = new Orbit(s.camera, s.renderer.domElement, () => { state.dirty = true; });
+    orbit.frame(s.viewBounds());  // leaves frame 0 shown
     s.showFrame(0, true);
-    orbit.frame(s.bounds(0));
 
     const playButton = $("play");
     const setPlaying = (on) => {
