@@ -72,7 +72,15 @@ TEST_CASE("deformer contacts: E_v = E max(1, A / s_v) for two overlap areas, and
     }
     CHECK(nOrig == info.numOriginalPoints);
     CHECK(nV == info.numVerticalPoints);
-    CHECK(info.numHorizontalPoints == 0);
+    Real horizontalForce = 0;
+    for (const ContactPoint& p : c->points())
+      if (p.frictionCoefficient == 0 && std::abs(p.normal.z()) < 1e-9) horizontalForce += p.normalForce;
+    CHECK(horizontalForce <= 1e-6 * mass * 9.81);
+    // At rest: the vertical points' friction (mu of their load) holds the box; the PGS residual of those rows
+    // leaves it creeping at most ~1e-7 m/s (measured 9.8e-8 and 1.3e-10 m/s), and a horizontal point built along
+    // that creep (d is any nonzero horizontal velocity) carries nothing that matters: < 1e-6 of the weight.
+    const Vec3 vh(box->getVelocity().x(), box->getVelocity().y(), 0);
+    CHECK(vh.norm() <= 1e-6);
     REQUIRE(nOrig > 0);
     const Real predicted = mass * 9.81 / (Real(nOrig) * (Ev + 100 * Terrain::kDeformerSoftness));
     const Real depth = -(box->getPosition().z() - 0.1);
@@ -97,7 +105,7 @@ TEST_CASE("deformer contacts: useContactDepth false gives vertical contacts of z
     if (!c || t->getLastStepDeformerContacts().empty()) continue;
     const Real Ev = t->getLastStepDeformerContacts().front().verticalYoungsModulus;
     for (const ContactPoint& p : c->points())
-      if (p.youngsModulus == Ev && p.frictionCoefficient == 0) {
+      if (p.youngsModulus == Ev && std::abs(p.normal.z()) == 1) {  // the vertical points (exactly +-z)
         ++seen;
         CHECK(p.depth == 0);
       }

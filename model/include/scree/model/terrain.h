@@ -375,7 +375,10 @@ struct TerrainShovelStats {
   Vec3 particleContactForce = Vec3::Zero();  ///< from contacts with terrain particles
   Real fillVolume = 0;                       ///< soil volume of the terrain particles in the shovel (m^3)
   size_t fillParticles = 0;
-  Vec3 diggingForce() const { return terrainContactForce + particleContactForce; }
+  /// The ground cutting force's row on a shovel that is also a deformer (TerrainDataInterface::
+  /// setShovelGroundCuttingForce): along forward, |.| <= the set force; zero for other shovels.
+  Vec3 groundCuttingForce = Vec3::Zero();
+  Vec3 diggingForce() const { return terrainContactForce + particleContactForce + groundCuttingForce; }
 };
 
 /// Particle attributes of a terrain (manual 25.1.2.8): the radius of particles made from now on.
@@ -690,8 +693,9 @@ class Terrain : public Model {
   /// Contact listener part: the ground cutting force on a shovel-terrain contact (TerrainDataInterface).
   void applyGroundCuttingForce(GeometryContact& contact, const Geometry& other);
   std::vector<TerrainShovelStats> shovelStats_;
-  /// Sum of the normal forces of each shovel's terrain contact points last step (N), for the deformer case.
-  std::vector<std::pair<const Geometry*, Real>> shovelNormalForce_;
+  /// The ground cutting rows of shovels that are deformers (one per shovel geometry; terrain_shovel.cpp).
+  class CuttingConstraint;
+  std::vector<std::shared_ptr<CuttingConstraint>> cutting_;
   // --- end shovel read-outs ----------------------------------------------------------------------------------
   // Particle contact materials (terrain_particle_materials.cpp).
   std::vector<const Material*> warnedMaterials_;  ///< the FAQ warning, logged once per material
