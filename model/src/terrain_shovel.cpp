@@ -41,9 +41,11 @@ class Terrain::CuttingConstraint : public Constraint {
   }
   const Geometry* shovel() const { return shovel_; }
   /// Armed for this step (the contact listener saw the shovel touch the terrain) with the force F, N.
-  void arm(Real force) { force_ = force, active_ = true; }
+  void arm(Real force) { force_ = force, active_ = true, solved_ = false; }
   bool active() const { return active_; }
-  void disarm() { active_ = false; }
+  /// True when this step's solve had the row (armed, and the shovel's body dynamic and in the simulation).
+  bool solved() const { return solved_; }
+  void disarm() { active_ = false, solved_ = false; }
   /// The world direction the row acted along in the last step (unit forward).
   const Vec3& direction() const { return dir_; }
 
@@ -73,12 +75,13 @@ class Terrain::CuttingConstraint : public Constraint {
     r.solveType = FrictionModel::ITERATIVE;
     rows.push_back(r);
     outDofs.push_back(0);
+    solved_ = true;
   }
 
  private:
   const Geometry* shovel_;
   Real force_ = 0;
-  bool active_ = false;
+  bool active_ = false, solved_ = false;
   Vec3 dir_ = Vec3::UnitX();
 };
 
@@ -176,8 +179,9 @@ void Terrain::updateShovelStats() {
   for (const GeometryRef& g : sim->getStaticGeometries()) consider(g);
   // The ground cutting rows of this step (shovels that are deformers): their force on the shovel, then disarmed.
   for (const auto& k : cutting_) {
-    if (!k->active()) continue;
+    const bool solved = k->solved();
     k->disarm();
+    if (!solved) continue;  // no row this step: no force (getCurrentForce would be an older step's)
     const auto it = index.find(k->shovel());
     if (it != index.end()) shovelStats_[it->second].groundCuttingForce += k->getCurrentForce(0) * k->direction();
   }
