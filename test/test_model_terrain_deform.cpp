@@ -2,7 +2,8 @@
 // vertical contact's Young's modulus E max(1, A/s_v) for two overlap areas; a deformer box resting with
 // useContactDepth true settles at the depth its vertical contacts' compliance predicts, with false its vertical
 // contacts have zero depth; a blade pushed through soil faster than the cut-off velocity builds a berm ahead with
-// the ledger exact after every step, harder to push the deeper it cuts; below the cut-off nothing moves; a
+// the ledger exact after every step, harder to push the deeper it cuts, its horizontal points of zero depth with
+// E_h = E max(1, A_h / s_h); below the cut-off nothing moves; a
 // blade turning in place deforms only above the angular cut-off.
 #include <doctest/doctest.h>
 
@@ -72,7 +73,15 @@ TEST_CASE("deformer contacts: E_v = E max(1, A / s_v) for two overlap areas, and
     }
     CHECK(nOrig == info.numOriginalPoints);
     CHECK(nV == info.numVerticalPoints);
-    CHECK(info.numHorizontalPoints == 0);
+    Real horizontalForce = 0;
+    for (const ContactPoint& p : c->points())
+      if (p.frictionCoefficient == 0 && std::abs(p.normal.z()) < 1e-9) horizontalForce += p.normalForce;
+    CHECK(horizontalForce <= 1e-6 * mass * 9.81);
+    // At rest: the vertical points' friction (mu of their load) holds the box; the PGS residual of those rows
+    // leaves it creeping at most ~1e-7 m/s (measured 9.8e-8 and 1.3e-10 m/s), and a horizontal point built along
+    // that creep (d is any nonzero horizontal velocity) carries nothing that matters: < 1e-6 of the weight.
+    const Vec3 vh(box->getVelocity().x(), box->getVelocity().y(), 0);
+    CHECK(vh.norm() <= 1e-6);
     REQUIRE(nOrig > 0);
     const Real predicted = mass * 9.81 / (Real(nOrig) * (Ev + 100 * Terrain::kDeformerSoftness));
     const Real depth = -(box->getPosition().z() - 0.1);
@@ -97,7 +106,7 @@ TEST_CASE("deformer contacts: useContactDepth false gives vertical contacts of z
     if (!c || t->getLastStepDeformerContacts().empty()) continue;
     const Real Ev = t->getLastStepDeformerContacts().front().verticalYoungsModulus;
     for (const ContactPoint& p : c->points())
-      if (p.youngsModulus == Ev && p.frictionCoefficient == 0) {
+      if (p.youngsModulus == Ev && std::abs(p.normal.z()) == 1) {  // the vertical points (exactly +-z)
         ++seen;
         CHECK(p.depth == 0);
       }
@@ -113,6 +122,10 @@ struct PushResult {
   Real worstDrift = 0;
   size_t pushed = 0;
   size_t maxArmed = 0;  ///< most vertices armed for avalanches at once
+  size_t horizontalPoints = 0;      ///< horizontal points seen (friction 0, horizontal normal)
+  size_t horizontalNonzeroDepth = 0;  ///< of which with a depth other than 0
+  Real worstEh = 0;  ///< max over steps of |E_h - E max(1, A_h / s_h)| / E_h (DeformerContactInfo)
+  Real largestAh = 0;  ///< m^2
 };
 
 /// A blade (0.1 m thick along x, 1 m wide, 0.4 m tall box; a deformer with useContactDepth false) driven through
@@ -152,6 +165,19 @@ PushResult pushBlade(Real depth, Real speed = 0.5, Real cutOff = Terrain::defaul
     r.pushed += t->getLastStepDeformStats().verticesPushed;
     r.maxArmed = std::max(r.maxArmed, t->getNumArmedVertices());
     const Real travelled = blade->getPosition().x() - x0;
+    // The horizontal points: zero depth (manual 25.1.2.18), E_h = E max(1, A_h / s_h) as for the vertical law.
+    if (const GeometryContact* c = findContact(w, *t))
+      for (const ContactPoint& p : c->points())
+        if (p.frictionCoefficient == 0 && std::abs(p.normal.z()) < 1e-9) {
+          ++r.horizontalPoints;
+          if (p.depth != 0) ++r.horizontalNonzeroDepth;
+        }
+    for (const auto& info : t->getLastStepDeformerContacts()) {
+      if (info.numHorizontalPoints == 0) continue;
+      const Real Eh = info.youngsModulus * std::max<Real>(1, info.horizontalArea / t->getHorizontalYoungsModulusAreaScaler());
+      r.worstEh = std::max(r.worstEh, std::abs(info.horizontalYoungsModulus - Eh) / Eh);
+      r.largestAh = std::max(r.largestAh, info.horizontalArea);
+    }
     // Horizontal points of the deformer contact (friction 0, normal horizontal), once the berm has formed.
     if (travelled > samples[0]) {
       ++forceSteps;
@@ -194,6 +220,11 @@ TEST_CASE("deformer blade: the ledger is exact every step, a berm grows ahead, d
     CHECK(r->worstDrift <= 1e-9);
     CHECK(r->pushed > 0);
     CHECK(r->maxArmed > 0);  // moved vertices arm avalanches (the berm slumps)
+    CHECK(r->horizontalPoints > 0);
+    CHECK(r->horizontalNonzeroDepth == 0);
+    CHECK(r->worstEh <= 1e-9);
+    // A_h = 1 m x (at least the cut depth) > s_h = 0.005 m^2: the scaled branch of the law is the one checked.
+    CHECK(r->largestAh > 10 * Terrain::defaultHorizontalYoungsModulusAreaScaler);
     REQUIRE(r->bermHeights.size() == 3);
     MESSAGE("berm heights " << r->bermHeights[0] << " " << r->bermHeights[1] << " " << r->bermHeights[2]
                             << ", resistance " << r->meanResistance << " N");

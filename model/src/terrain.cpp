@@ -141,7 +141,10 @@ void Terrain::onAdd(Simulation& sim) {
   syncParticleContactMaterials();  // into this simulation's MaterialManager (terrain_particle_materials.cpp)
 }
 
-void Terrain::onRemove(Simulation&) {}
+void Terrain::onRemove(Simulation&) {
+  // The ground cutting rows leave with the model's owned items; made again on the next touch after a re-add.
+  cutting_.clear();
+}
 
 void Terrain::setLoadAveragingTime(Real seconds) {
   detail::requireNonNegative("Terrain::setLoadAveragingTime", "seconds", seconds);

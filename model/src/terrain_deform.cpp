@@ -121,6 +121,7 @@ void Terrain::modifyDeformerContact(GeometryContact& c, int self) {
   const size_t n0 = c.points().size();
   info.numOriginalPoints = n0;
   const Real Ec = c.material().getYoungsModulus();
+  const Real muContact = c.material().getFrictionCoefficient();
   c.points().reserve(3 * n0);
   const Vec3 nV = self == 1 ? up : Vec3(-up);   // from geometry 1 to geometry 0: pushes the deformer up
   const Vec3 nH = self == 1 ? Vec3(-d) : d;     // pushes the deformer against its motion
@@ -139,6 +140,9 @@ void Terrain::modifyDeformerContact(GeometryContact& c, int self) {
     q.frictionDirection = Vec3::Zero();
     ContactPoint v = q;
     v.normal = nV;
+    // The vertical point carries the load, so it carries the friction too: mu bounded by its own normal force
+    // (terrain.h: the friction of a deformer contact is mu times the load of the generated vertical points).
+    v.frictionCoefficient = p.frictionCoefficient >= 0 ? p.frictionCoefficient : muContact;
     v.depth = info.useContactDepth ? std::max<Real>(0, p.depth * std::abs(p.normal.dot(up))) : 0;
     v.youngsModulus = Ev;
     v.featureId = p.featureId ^ 0x40000000u;
@@ -147,7 +151,7 @@ void Terrain::modifyDeformerContact(GeometryContact& c, int self) {
     hz.depth = 0;
     hz.youngsModulus = Eh;
     hz.featureId = p.featureId ^ 0x80000000u;
-    p.youngsModulus = E * kDeformerSoftness;  // very soft: carries the friction
+    p.youngsModulus = E * kDeformerSoftness;  // very soft; keeps its friction (bounded by its own small load)
     c.points().push_back(v);  // may reallocate: p is not used after this
     ++info.numVerticalPoints;
     if (hasDir) {

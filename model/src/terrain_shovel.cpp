@@ -7,7 +7,9 @@
 
 #include "scree/core/errors.h"
 #include "scree/model/terrain.h"
+#include "scree/solver/constraint.h"
 #include "scree/solver/simulation.h"
+#include "scree/solver/spook.h"
 
 namespace scree {
 
@@ -24,24 +26,100 @@ namespace {
 bool isDeformer(const Geometry& g) { return Terrain::isGeometryDeformer(g); }
 }  // namespace
 
+// ---- ground cutting force of a shovel that is also a deformer: one friction-like row along forward -------------
+// terrain.h ("A shovel that is also a deformer"): a velocity row on the relative velocity of the shovel and the
+// terrain at the cutting edge along the shovel's forward direction, target 0, impulse bounds +-F h. It acts only
+// along forward (a shovel sliding sideways does not feel it), holds the shovel while the other forces along
+// forward stay below F, and applies exactly F against the motion while the edge moves along forward.
+class Terrain::CuttingConstraint : public Constraint {
+ public:
+  CuttingConstraint(RigidBodyRef shovelBody, RigidBodyRef terrainBody, const Geometry* shovel)
+      : Constraint(std::move(shovelBody), std::move(terrainBody), 1, "TerrainGroundCutting"), shovel_(shovel) {
+    setName("ground cutting force");
+    setSolveType(FrictionModel::ITERATIVE);  // a bounded row: PGS clamps it, no LCP in the direct solver
+    setEnableCollisions(true);               // the shovel keeps colliding with the terrain
+  }
+  const Geometry* shovel() const { return shovel_; }
+  /// Armed for this step (the contact listener saw the shovel touch the terrain) with the force F, N.
+  void arm(Real force) { force_ = force, active_ = true, solved_ = false; }
+  bool active() const { return active_; }
+  /// True when this step's solve had the row (armed, and the shovel's body dynamic and in the simulation).
+  bool solved() const { return solved_; }
+  void disarm() { active_ = false, solved_ = false; }
+  /// The world direction the row acted along in the last step (unit forward).
+  const Vec3& direction() const { return dir_; }
+
+  void addRows(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows,
+               std::vector<int>& outDofs) override {
+    if (!active_) return;
+    const Transform& G = shovel_->getTransform();  // this step's collision pose
+    const Vec3 fwdLocal = shovel_->getPropertyContainer().getPropertyVec3(ShovelForwardProperty);
+    const Vec3 fwd = G.rotate(fwdLocal);
+    if (!(fwd.norm() > 0)) return;
+    dir_ = fwd.normalized();
+    const Vec3 tip = G.p + fwd;  // the cutting edge (terrain.h, shovels)
+    detail::ConstraintRow r;
+    r.bodyA = ctx.indexA;
+    r.bodyB = ctx.indexB;
+    r.jLinA = dir_;
+    r.jAngA = (tip - a_->getCmPosition()).cross(dir_);
+    if (b_) {
+      r.jLinB = -dir_;
+      r.jAngB = -(tip - b_->getCmPosition()).cross(dir_);
+    }
+    r.rhs = 0;  // no relative motion along forward unless the other forces exceed F
+    r.e = spookVelocityRegularisation(ctx.h, getCompliance(0));
+    r.lo = -force_ * ctx.h;
+    r.hi = force_ * ctx.h;
+    r.lambda = std::clamp(warm_[0], r.lo, r.hi);
+    r.solveType = FrictionModel::ITERATIVE;
+    rows.push_back(r);
+    outDofs.push_back(0);
+    solved_ = true;
+  }
+
+ private:
+  const Geometry* shovel_;
+  Real force_ = 0;
+  bool active_ = false, solved_ = false;
+  Vec3 dir_ = Vec3::UnitX();
+};
+
+namespace {
+RigidBodyRef refOf(Simulation& sim, const RigidBody* b) {
+  if (!b) return nullptr;
+  for (const RigidBodyRef& r : sim.getRigidBodies())
+    if (r.get() == b) return r;
+  return nullptr;
+}
+}  // namespace
+
 // ---- ground cutting force: the contact listener part ------------------------------------------------------------
 void Terrain::applyGroundCuttingForce(GeometryContact& c, const Geometry& other) {
   const Real value = data_->getShovelGroundCuttingForce();
   if (!(value > 0) || !isGeometryShovel(other)) return;
-  const Real muContact = c.material().getFrictionCoefficient();
   if (isDeformer(other)) {
-    // A constant force: raise every point's coefficient by value / N_last (terrain_data_interface.h).
-    Real nLast = 0;
-    for (const auto& [g, n] : shovelNormalForce_)
-      if (g == &other) nLast = n;
-    if (!(nLast > 0)) return;
-    const Real dMu = value / nLast;
-    for (ContactPoint& p : c.points()) {
-      const Real mu = p.frictionCoefficient >= 0 ? p.frictionCoefficient : muContact;
-      p.frictionCoefficient = mu + dMu;
+    // A constant force along forward: the shovel's cutting row (CuttingConstraint above), armed for this step.
+    if (!c.isEnabled() || c.isSensor() || c.points().empty()) return;
+    const RigidBody* body = other.getRigidBody();
+    if (!body || body == geometry_->getRigidBody()) return;  // a static shovel does not move: nothing to resist
+    CuttingConstraint* row = nullptr;
+    for (const auto& k : cutting_)
+      if (k->shovel() == &other && k->getBodyAt(0) == body) row = k.get();
+    if (!row) {
+      Simulation* sim = getSimulation();
+      RigidBodyRef a = sim ? refOf(*sim, body) : nullptr;
+      if (!a) return;
+      RigidBodyRef b = geometry_->getRigidBody() ? refOf(*sim, geometry_->getRigidBody()) : nullptr;
+      auto k = std::make_shared<CuttingConstraint>(a, b, &other);
+      cutting_.push_back(k);
+      addOwned(ConstraintRef(k));  // rows only while armed (addRows), so it may stay installed
+      row = k.get();
     }
+    row->arm(value);
   } else {
     // A scale on the friction coefficient: mu (1 + value).
+    const Real muContact = c.material().getFrictionCoefficient();
     for (ContactPoint& p : c.points()) {
       const Real mu = p.frictionCoefficient >= 0 ? p.frictionCoefficient : muContact;
       p.frictionCoefficient = mu * (1 + value);
@@ -60,7 +138,6 @@ TerrainShovelStats Terrain::getShovelStats(const Geometry& shovel) const {
 
 void Terrain::updateShovelStats() {
   shovelStats_.clear();
-  shovelNormalForce_.clear();
   Simulation* sim = getSimulation();
   if (!sim) return;
   // 1. The valid shovels, with the region their fill is counted in (terrain.h).
@@ -100,9 +177,15 @@ void Terrain::updateShovelStats() {
   for (const RigidBodyRef& b : sim->getRigidBodies())
     for (const GeometryRef& g : b->getGeometries()) consider(g);
   for (const GeometryRef& g : sim->getStaticGeometries()) consider(g);
+  // The ground cutting rows of this step (shovels that are deformers): their force on the shovel, then disarmed.
+  for (const auto& k : cutting_) {
+    const bool solved = k->solved();
+    k->disarm();
+    if (!solved) continue;  // no row this step: no force (getCurrentForce would be an older step's)
+    const auto it = index.find(k->shovel());
+    if (it != index.end()) shovelStats_[it->second].groundCuttingForce += k->getCurrentForce(0) * k->direction();
+  }
   if (shovelStats_.empty()) return;
-  shovelNormalForce_.reserve(shovelStats_.size());
-  for (const TerrainShovelStats& s : shovelStats_) shovelNormalForce_.emplace_back(s.shovel, 0.0);
 
   // 2. Contacts with the terrain geometry: geometry 0 is pushed along +normal (normalForce n + frictionForce).
   for (const GeometryContact& c : sim->getContacts()) {
@@ -114,7 +197,6 @@ void Terrain::updateShovelStats() {
     for (const ContactPoint& p : c.points()) {
       if (!p.enabled) continue;
       shovelStats_[it->second].terrainContactForce += sign * (p.normalForce * p.normal + p.frictionForce);
-      shovelNormalForce_[it->second].second += p.normalForce;
     }
   }
 

@@ -171,9 +171,9 @@
 //     deformer's body at the box centre, else the mean horizontal part of the contact normals (toward the
 //     deformer), else none. Why the box: exact for an axis-aligned box (a blade, a plate), conservative for
 //     other shapes, and the deformation below reads the same overlap, so both halves agree.
-//   - per original point p, a vertical point (along the field's +z, friction 0, featureId ^ 0x40000000) with
-//     depth = p.depth |n.z| when useContactDepth is true (the penetration vector projected on the vertical),
-//     else 0, and E_v = E max(1, A_v / s_v);
+//   - per original point p, a vertical point (along the field's +z, featureId ^ 0x40000000, friction mu = p's)
+//     with depth = p.depth |n.z| when useContactDepth is true (the penetration vector projected on the
+//     vertical), else 0, and E_v = E max(1, A_v / s_v);
 //   - and, when d exists and t > 0, a horizontal point (normal -d on the deformer: the soil resists the motion,
 //     friction 0, featureId ^ 0x80000000) with depth 0 (the manual: nonzero horizontal depths push in opposite
 //     directions and fail the solver) and E_h = E max(1, A_h / s_h) - the same law as the vertical one, as the
@@ -181,8 +181,35 @@
 //     but the manual's section names no nonlinearity and its FAQ - a lower scale gives stiffer contacts - holds
 //     for this law, so we keep the manual's); a zero-depth contact resists the approach velocity
 //     with a compliance 1/E_h, so the resistance grows with the submerged frontal area, i.e. with depth;
-//   - the original point keeps its friction and gets E kDeformerSoftness (1e-3 E): very soft, it carries the
-//     friction (bounded by mu times its own small normal force - a limit of this reading).
+//   - the original point keeps its friction and gets E kDeformerSoftness (1e-3 E): very soft.
+// Friction. The manual has the very soft original contact "handle the friction". The solver bounds a point's
+// friction rows by that point's own normal impulse, and the original point, 1e-3 as stiff as the vertical one,
+// carries about 1e-3 of the load: alone it would grip with mu x 1e-3 of the weight (a resting deformer slid off
+// under any push). So the vertical points carry the friction too, with the original point's mu: the contact's
+// friction bound is mu (N_v + N_o), mu times the load the vertical points carry (plus the original's small
+// share) - Coulomb's law on the load, in the same solve (no lag from a last-step force). Their friction rows lie
+// in the field's horizontal plane; the original points keep theirs in the real surface's tangent plane. The
+// horizontal points have none (they stand for soil pushed, not for a surface sliding).
+//
+// A shovel that is also a deformer (the manual's recommended set-up for buckets: 25.1.2.13, 25.1.2.15). Both
+// parts act on it, each as for a plain shovel or deformer, in the order of the step: the cut (pre-collide) lowers
+// its footprint and lead to the cutting plane (never below the box's bottom) and books heightField -> pending;
+// the deformer contact rebuild (contact listener) and the push (post step) then see those lowered heights and
+// move only soil still above the box's bottom (a bucket whose bottom lies below its cutting plane pushes that
+// layer ahead, where the next step's cut takes it). Each operation reads the heights as the previous one left
+// them and books only its own moves (the cut heightField -> pending, the push nothing: heightField to
+// heightField), so the same soil is never counted twice and the ledger stays exact.
+// Its ground cutting force (TerrainDataInterface::setShovelGroundCuttingForce, F in N) is a friction force in
+// the forward direction (the manual: "a constant friction force in the shovel forward direction"): one
+// velocity row of the terrain's own (Terrain::CuttingConstraint, terrain_shovel.cpp) on the relative velocity
+// of the shovel and the terrain at the cutting edge (the tip) along the unit forward direction (world), target
+// 0, impulse bounds +-F h, solved iteratively with the step's other rows. It is armed on a step where the
+// shovel's body touches the terrain (the contact listener saw an enabled contact with points) and F > 0,
+// otherwise it has no row; like contact rows it acts only on a dynamic body (a kinematic path ignores forces). So: moving along forward (or backward) the shovel meets exactly F against the
+// motion; held, it stays put while the other forces along forward stay below F; sliding sideways it meets
+// nothing from it (a row along forward does not see motion across it). Why a row and not the friction rows:
+// those act in every tangential direction, and raising their coefficients by F / N (the first reading) gave F
+// against any sliding, sideways too. The force is read back as TerrainShovelStats::groundCuttingForce.
 // s_v, s_h: setVerticalYoungsModulusAreaScaler / setHorizontalYoungsModulusAreaScaler (m^2, finite, > 0;
 // defaults 0.01, the manual's example, and 0.005, lower than the vertical as the manual's rule of thumb says).
 // E is the point's E after compression (the contact material's E x m(c)).
@@ -350,6 +377,8 @@ class Terrain;
 //   terrainContactForce   sum over the enabled, non-sensor contact points between the shovel geometry and the
 //                         terrain geometry of the force the solver applied on the shovel (normal + friction,
 //                         world frame, N; adhesion pulling counts with its sign).
+//   groundCuttingForce    the ground cutting row's force on a shovel that is also a deformer (world, N; along
+//                         forward, |.| <= F; zero otherwise). diggingForce() sums the three forces.
 //   particleContactForce  the same over the particle-geometry contacts between the shovel geometry and the
 //                         live particles this terrain made (GranularBodySystem contact lists: the force on the
 //                         particle is normalForce * normal + frictionForce, the shovel feels its negative).
@@ -375,7 +404,10 @@ struct TerrainShovelStats {
   Vec3 particleContactForce = Vec3::Zero();  ///< from contacts with terrain particles
   Real fillVolume = 0;                       ///< soil volume of the terrain particles in the shovel (m^3)
   size_t fillParticles = 0;
-  Vec3 diggingForce() const { return terrainContactForce + particleContactForce; }
+  /// The ground cutting force's row on a shovel that is also a deformer (TerrainDataInterface::
+  /// setShovelGroundCuttingForce): along forward, |.| <= the set force; zero for other shovels.
+  Vec3 groundCuttingForce = Vec3::Zero();
+  Vec3 diggingForce() const { return terrainContactForce + particleContactForce + groundCuttingForce; }
 };
 
 /// Particle attributes of a terrain (manual 25.1.2.8): the radius of particles made from now on.
@@ -690,8 +722,9 @@ class Terrain : public Model {
   /// Contact listener part: the ground cutting force on a shovel-terrain contact (TerrainDataInterface).
   void applyGroundCuttingForce(GeometryContact& contact, const Geometry& other);
   std::vector<TerrainShovelStats> shovelStats_;
-  /// Sum of the normal forces of each shovel's terrain contact points last step (N), for the deformer case.
-  std::vector<std::pair<const Geometry*, Real>> shovelNormalForce_;
+  /// The ground cutting rows of shovels that are deformers (one per shovel geometry; terrain_shovel.cpp).
+  class CuttingConstraint;
+  std::vector<std::shared_ptr<CuttingConstraint>> cutting_;
   // --- end shovel read-outs ----------------------------------------------------------------------------------
   // Particle contact materials (terrain_particle_materials.cpp).
   std::vector<const Material*> warnedMaterials_;  ///< the FAQ warning, logged once per material

@@ -133,17 +133,17 @@ class TerrainDataInterface {
   /// Extra resistance a shovel meets where it touches the terrain (finite, >= 0; default 0 = no effect; otherwise
   /// std::invalid_argument, unchanged). Read on every shovel-terrain contact point by the terrain's contact
   /// listener, so it may change at run time (a full bucket digs harder):
-  ///  - a shovel that is also a deformer (bool geometry property Terrain::DeformerProperty true): a force, N -
-  ///    the contact's friction bound grows by this much (a friction-like force, so it resists sliding and never
-  ///    drives the shovel). Each point's friction coefficient is raised by value / N_last, N_last the sum of the
-  ///    normal forces of the shovel's terrain contact points in the last step, so the points' bounds add up to
-  ///    mu N + value N / N_last (= mu N + value once the normal force is steady; nothing on the first step of a
-  ///    touch, when N_last = 0).
+  ///  - a shovel that is also a deformer (bool geometry property Terrain::DeformerProperty, either value): a
+  ///    force, N - a friction force along the shovel's forward direction only (terrain.h, "A shovel that is also a
+  ///    deformer"): one velocity row at the cutting edge along forward, impulse bounds +-value h, armed on the
+  ///    steps the shovel touches the terrain. It resists motion along forward with exactly `value`, holds the
+  ///    shovel below it, never drives it, and does not resist sideways sliding. Read back as
+  ///    TerrainShovelStats::groundCuttingForce.
   ///  - any other shovel: a dimensionless scale - each point's friction coefficient mu(shovel, terrain) becomes
   ///    mu (1 + value), so the friction bound is (1 + value) mu N. Why 1 + value and not value: 0 must leave
-  ///    the contact as it was (the default), and a scale of 0 would remove its friction.
-  /// Both act through the contact points' friction (the solver's friction rows), hence in every tangential
-  /// direction: a shovel moving along its forward direction meets it as a force against that motion.
+  ///    the contact as it was (the default), and a scale of 0 would remove its friction. This one acts through
+  ///    the contact points' friction rows, hence in every tangential direction (the manual: "a friction
+  ///    coefficient scale").
   virtual void setShovelGroundCuttingForce(Real force);
   Real getShovelGroundCuttingForce() const { return groundCuttingForce_; }
   // --- end ground cutting force -------------------------------------------------------------------------------
