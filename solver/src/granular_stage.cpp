@@ -65,11 +65,11 @@ GranularStage::PairParams GranularStage::makeParams(const SurfaceParameters& s, 
   return p;
 }
 
-const GranularStage::CacheEntry* GranularStage::find(const std::vector<CacheEntry>& cache, uint64_t key,
-                                                     uint32_t feature) const {
-  CacheEntry probe{key, feature, 0, Vec3::Zero(), Vec3::Zero(), 0};
-  auto it = std::lower_bound(cache.begin(), cache.end(), probe);
-  if (it != cache.end() && it->key == key && it->feature == feature) return &*it;
+const GranularStage::CacheEntry* GranularStage::find(const std::vector<CacheKey>& keys,
+                                                     const std::vector<CacheEntry>& entries, uint64_t key,
+                                                     uint32_t feature) {
+  auto it = std::lower_bound(keys.begin(), keys.end(), CacheKey{key, feature, 0});
+  if (it != keys.end() && it->key == key && it->feature == feature) return &entries[it->entry];
   return nullptr;
 }
 
@@ -245,9 +245,9 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
         const uint64_t sa = slotKey(idA), sb = slotKey(ps.idOfDense(size_t(c.b)));
         u.flip = sa > sb;
         sgn = u.flip ? -1.0 : 1.0;
-        ce = find(ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
+        ce = find(ppKeys_, ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
       } else {
-        ce = find(pgCache_, slotKey(idA) << 32 | sides[k - pp.size()].geometryId, c.featureId);
+        ce = find(pgKeys_, pgCache_, slotKey(idA) << 32 | sides[k - pp.size()].geometryId, c.featureId);
       }
     }
     const Real vn0 = u.n.dot(vrel);
@@ -751,8 +751,8 @@ void GranularStage::storeResults(const GranularBodySystem& ps, const ParticleCon
   auto& pg = *contacts.particleGeometry;
   const auto& sides = *contacts.geometrySides;
   const Real invH = 1.0 / h;
-  nextPp_.clear();
-  nextPg_.clear();
+  ppCache_.clear();
+  pgCache_.clear();
   for (const Unit& u : units_) {
     if (!ps.isAliveDense(u.a) || (u.b >= 0 && !ps.isAliveDense(size_t(u.b)))) continue;
     const Vec3 F = u.lT1 * u.t1 + u.lT2 * u.t2;
@@ -764,15 +764,18 @@ void GranularStage::storeResults(const GranularBodySystem& ps, const ParticleCon
     if (u.b >= 0) {
       const uint64_t sb = slotKey(ps.idOfDense(size_t(u.b)));
       const Real s = u.flip ? -1.0 : 1.0;
-      nextPp_.push_back({u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0, u.lN, s * F, s * T, u.impact});
+      ppCache_.push_back({u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0, u.lN, s * F, s * T, u.impact});
     } else {
-      nextPg_.push_back({sa << 32 | sides[u.src].geometryId, c.featureId, u.lN, F, T, u.impact});
+      pgCache_.push_back({sa << 32 | sides[u.src].geometryId, c.featureId, u.lN, F, T, u.impact});
     }
   }
-  std::sort(nextPp_.begin(), nextPp_.end());
-  std::sort(nextPg_.begin(), nextPg_.end());
-  std::swap(ppCache_, nextPp_);
-  std::swap(pgCache_, nextPg_);
+  auto index = [](const std::vector<CacheEntry>& entries, std::vector<CacheKey>& keys) {
+    keys.resize(entries.size());
+    for (size_t e = 0; e < entries.size(); ++e) keys[e] = {entries[e].key, entries[e].feature, uint32_t(e)};
+    std::sort(keys.begin(), keys.end());
+  };
+  index(ppCache_, ppKeys_);
+  index(pgCache_, pgKeys_);
 }
 
 }  // namespace scree::detail
