@@ -41,7 +41,39 @@ SCREE_UNIT_INLINE inline Vec3 rollingImpulse(U& u, const Vec3& wr) {
   return T;
 }
 
-uint64_t slotKey(size_t id) { return uint64_t(uint32_t(id & 0xffffffffu)); }
+/// Warm-start key of a particle: the low 32 bits of its id (its slot, stable while it lives).
+uint64_t slotKey(const GranularBodySystem& ps, size_t dense) { return uint64_t(ps.idLowOfDense(dense)); }
+
+/// Sorts (height, code) pairs pushed in increasing code order into (height, code) order, as std::sort with
+/// the pair's operator< would: a stable LSD radix sort (8 passes of 8 bits) on the heights' bits mapped to an
+/// unsigned order, which keeps equal heights in code order. About a quarter of std::sort's time here (the shock
+/// order has 10,000-20,000 entries in the trench bench). -0 is taken as +0 (equal for operator<); the heights
+/// are finite (integrate stops a particle before its position turns non-finite).
+void sortByHeight(std::vector<std::pair<Real, uint32_t>>& v, std::vector<std::pair<Real, uint32_t>>& tmp) {
+  static_assert(sizeof(Real) == sizeof(uint64_t));
+  const size_t n = v.size();
+  if (n < 64) {
+    std::sort(v.begin(), v.end());
+    return;
+  }
+  auto bits = [](Real h) {
+    const uint64_t u = std::bit_cast<uint64_t>(h + 0.0);  // -0 + 0 = +0
+    return (u >> 63) ? ~u : u | (uint64_t(1) << 63);
+  };
+  tmp.resize(n);
+  auto* src = &v;
+  auto* dst = &tmp;
+  for (int pass = 0; pass < 8; ++pass) {
+    const int shift = 8 * pass;
+    uint32_t count[257] = {};
+    for (const auto& e : *src) ++count[((bits(e.first) >> shift) & 0xff) + 1];
+    if (count[((bits((*src)[0].first) >> shift) & 0xff) + 1] == n) continue;  // all share this digit
+    for (int d = 0; d < 256; ++d) count[d + 1] += count[d];
+    for (const auto& e : *src) (*dst)[count[(bits(e.first) >> shift) & 0xff]++] = e;
+    std::swap(src, dst);
+  }
+  if (src != &v) v.swap(tmp);
+}
 
 }  // namespace
 
@@ -240,14 +272,13 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     const CacheEntry* ce = nullptr;
     Real sgn = 1.0;
     {
-      const size_t idA = ps.idOfDense(a);
       if (isPP) {
-        const uint64_t sa = slotKey(idA), sb = slotKey(ps.idOfDense(size_t(c.b)));
+        const uint64_t sa = slotKey(ps, a), sb = slotKey(ps, size_t(c.b));
         u.flip = sa > sb;
         sgn = u.flip ? -1.0 : 1.0;
         ce = find(ppKeys_, ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
       } else {
-        ce = find(pgKeys_, pgCache_, slotKey(idA) << 32 | sides[k - pp.size()].geometryId, c.featureId);
+        ce = find(pgKeys_, pgCache_, slotKey(ps, a) << 32 | sides[k - pp.size()].geometryId, c.featureId);
       }
     }
     const Real vn0 = u.n.dot(vrel);
@@ -583,7 +614,7 @@ void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyStat
     // Freeze the lower particle.
     shockOrder_.push_back(ha < hb ? std::make_pair(ha, k * 2 + 0) : std::make_pair(hb, k * 2 + 1));
   }
-  std::sort(shockOrder_.begin(), shockOrder_.end());
+  sortByHeight(shockOrder_, shockScratch_);
   auto& v = ps.velocities();
   auto& w = ps.angularVelocities();
   Real unused = 0;
@@ -760,9 +791,9 @@ void GranularStage::storeResults(const GranularBodySystem& ps, const ParticleCon
     ParticleContact& c = u.b >= 0 ? pp[u.src] : pg[u.src];
     c.normalForce = u.lN * invH;
     c.frictionForce = F * invH;
-    const uint64_t sa = slotKey(ps.idOfDense(u.a));
+    const uint64_t sa = slotKey(ps, u.a);
     if (u.b >= 0) {
-      const uint64_t sb = slotKey(ps.idOfDense(size_t(u.b)));
+      const uint64_t sb = slotKey(ps, size_t(u.b));
       const Real s = u.flip ? -1.0 : 1.0;
       ppCache_.push_back({u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0, u.lN, s * F, s * T, u.impact});
     } else {

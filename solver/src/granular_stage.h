@@ -213,6 +213,7 @@ class GranularStage {
   std::vector<uint32_t> pgParam_, pgUnit_;  // per particle-geometry contact: its pgParams_ entry and unit
   std::vector<int32_t> pgBody_;             // per particle-geometry contact: solver body, -1 none
   std::vector<std::pair<Real, uint32_t>> shockOrder_;  // (height of the lower side, unit * 2 + frozen side)
+  std::vector<std::pair<Real, uint32_t>> shockScratch_;  // the radix sort's second buffer
   std::vector<CacheEntry> ppCache_, pgCache_;
   std::vector<CacheKey> ppKeys_, pgKeys_;
   // DIRECT mode, valid between appendDirectRows and finishDirect.
