@@ -212,8 +212,8 @@ class GranularStage {
   std::vector<std::pair<std::pair<uint32_t, const Material*>, PairParams>> pgParams_;  // pairs met this step
   std::vector<uint32_t> pgParam_, pgUnit_;  // per particle-geometry contact: its pgParams_ entry and unit
   std::vector<int32_t> pgBody_;             // per particle-geometry contact: solver body, -1 none
-  std::vector<std::pair<Real, uint32_t>> shockOrder_;  // (height of the lower side, unit * 2 + frozen side)
-  std::vector<std::pair<Real, uint32_t>> shockScratch_;  // the radix sort's second buffer
+  // (height of the lower side as an order-preserving key, unit * 2 + frozen side), and the radix sort's buffer.
+  std::vector<std::pair<uint64_t, uint32_t>> shockOrder_, shockScratch_;
   std::vector<CacheEntry> ppCache_, pgCache_;
   std::vector<CacheKey> ppKeys_, pgKeys_;
   // DIRECT mode, valid between appendDirectRows and finishDirect.
