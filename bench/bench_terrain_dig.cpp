@@ -20,6 +20,8 @@
 //   st_<stage>    Simulation::getTimings() per stage, mean over the >= 5,000 steps (ms); the stages add up to
 //                 the step
 //   drift         |ledger total - start| / start at the end (the soil is conserved)
+// On a shared machine run the 2-thread case with OMP_WAIT_POLICY=passive (docs/terrain.md, "Digging cost": with
+// the default spinning, each barrier waits for a parked thread and 2 threads take twice one thread's time).
 // With the environment variable SCREE_DIG_HASH set, each run also prints to stderr a fingerprint (FNV-1a over
 // the particles' positions and velocities every 10 steps) and the created / merged totals: two builds whose
 // fingerprints match computed the same trench bit for bit (how the optimisations of docs/terrain.md, "Digging
