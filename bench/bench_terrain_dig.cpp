@@ -20,12 +20,20 @@
 //   st_<stage>    Simulation::getTimings() per stage, mean over the >= 5,000 steps (ms); the stages add up to
 //                 the step
 //   drift         |ledger total - start| / start at the end (the soil is conserved)
+// On a shared machine run the 2-thread case with OMP_WAIT_POLICY=passive (docs/terrain.md, "Digging cost": with
+// the default spinning, each barrier waits for a parked thread and 2 threads take twice one thread's time).
+// With the environment variable SCREE_DIG_HASH set, each run also prints to stderr a fingerprint (FNV-1a over
+// the particles' positions and velocities every 10 steps) and the created / merged totals: two builds whose
+// fingerprints match computed the same trench bit for bit (how the optimisations of docs/terrain.md, "Digging
+// cost", were checked). Hashing costs time: leave it unset for timings.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <cstdio>
+#include <cstdlib>
 #include <vector>
 
 #include "scenes/terrain_dig.h"
@@ -64,6 +72,8 @@ void BM_terrain_dig(benchmark::State& state) {
     size_t liveMax = 0, created = 0, merged = 0;
     double contacts = 0;
     const int n = s.totalSteps();
+    const bool hashOn = std::getenv("SCREE_DIG_HASH") != nullptr;  // fingerprint (see the file comment)
+    uint64_t hsh = 1469598103934665603ull;
     for (int i = 0; i < n; ++i) {
       const size_t live = s.sim->getGranularBodySystem().numParticles();
       const size_t phase = s.currentPhase();
@@ -73,6 +83,14 @@ void BM_terrain_dig(benchmark::State& state) {
       const double cpu = cpuMs() - c0;
       const double ms = std::chrono::duration<double>(Clock::now() - t0).count() * 1e3;
       all.push_back(ms);
+      if (hashOn && i % 10 == 0) {
+        const auto& ps = s.sim->getGranularBodySystem();
+        auto mix = [&](const void* p, size_t nbytes) {
+          for (size_t q = 0; q < nbytes; ++q) hsh = (hsh ^ static_cast<const unsigned char*>(p)[q]) * 1099511628211ull;
+        };
+        mix(ps.positions().data(), ps.positions().size() * sizeof(Vec3));
+        mix(ps.velocities().data(), ps.velocities().size() * sizeof(Vec3));
+      }
       if (phase <= 1) dig.push_back(ms);
       liveMax = std::max(liveMax, s.sim->getGranularBodySystem().numParticles());
       created += s.terrain->getLastStepDigStats().particlesCreated;
@@ -95,6 +113,7 @@ void BM_terrain_dig(benchmark::State& state) {
       }
     }
     state.PauseTiming();
+    if (hashOn) std::fprintf(stderr, "HASH threads=%d created=%zu merged=%zu hash=%016llx\n", threads, created, merged, (unsigned long long)hsh);
     const double nb = std::max<double>(1, double(big.size()));
     state.counters["ms_all"] = median(all);
     state.counters["ms_dig"] = median(dig);

@@ -63,6 +63,9 @@ struct ParticleCollider::Impl {
   };
   std::vector<Entry> entries;               // [sorted.size()]
   std::vector<std::vector<ParticleContact>> chunkOut;  // per chunk
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> chunkPairs;  // per chunk: pairs (lower, higher) found
+  std::vector<uint32_t> pairStart;  // [size() + 1] first pair of each lower particle in pairB
+  std::vector<uint32_t> pairB;      // the pairs' higher particles, by lower particle
   // Per-thread probe sphere for the geometry narrowphase.
   std::vector<std::shared_ptr<Sphere>> probeShapes;
   std::vector<std::unique_ptr<Geometry>> probes;
@@ -135,20 +138,25 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
   }
 
   // ---- particle pairs ----------------------------------------------------------------------------------------
+  // Half stencil: a particle looks at its own cell (partners of higher index only) and the 13 neighbour cells
+  // that come after its own in (z, y, x) order, so each pair of cells is visited from one side only (the full
+  // 27-cell stencil met every candidate pair twice and rejected one visit by index). A pair found from the
+  // higher particle's side is stored as (lower, higher); the pairs are then put in (a, b) order by a counting
+  // sort on a and a sort of each a's few partners, and the contacts are computed from a's side exactly as
+  // before (d = x_a - x_b): the same contact list in the same order, bit for bit.
   const size_t numChunks = (n + kChunk - 1) / kChunk;
-  if (m.chunkOut.size() < numChunks) m.chunkOut.resize(numChunks);
+  if (m.chunkPairs.size() < numChunks) m.chunkPairs.resize(numChunks);
 #pragma omp parallel for schedule(dynamic, 1) if (numChunks >= kParallelChunks)
   for (size_t c = 0; c < numChunks; ++c) {
-    auto& out = m.chunkOut[c];
+    auto& out = m.chunkPairs[c];
     out.clear();
     const size_t end = std::min(n, (c + 1) * kChunk);
     for (size_t i = c * kChunk; i < end; ++i) {
       if (!ps.isAliveDense(i)) continue;
       const Vec3 xi = x[i];
       const Real ri = r[i];
-      const size_t firstNew = out.size();
       // Position of the centre within its cell, in cells: a neighbour cell whose nearest point is at least one
-      // cell (>= r_i + r_j + reach) away holds no candidate, so it is not visited (about a quarter of the 27).
+      // cell (>= r_i + r_j + reach) away holds no candidate, so it is not visited (about a quarter of them).
       const Vec3 f = xi * m.invCell - Vec3(m.cx[i], m.cy[i], m.cz[i]);
       Real gap2[3][3];  // [axis][offset + 1]: squared distance (cells) to the neighbour slab along the axis
       for (int ax = 0; ax < 3; ++ax) {
@@ -157,17 +165,18 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
         gap2[ax][1] = 0;
         gap2[ax][2] = hi * hi;
       }
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
+      for (int dz = 0; dz <= 1; ++dz)
+        for (int dy = dz == 0 ? 0 : -1; dy <= 1; ++dy)
+          for (int dx = dz == 0 && dy == 0 ? 0 : -1; dx <= 1; ++dx) {
             if (gap2[0][dx + 1] + gap2[1][dy + 1] + gap2[2][dz + 1] >= 1) continue;
+            const bool own = dx == 0 && dy == 0 && dz == 0;
             const int64_t qx = int64_t(m.cx[i]) + dx, qy = int64_t(m.cy[i]) + dy, qz = int64_t(m.cz[i]) + dz;
             const size_t b = hashCell(qx, qy, qz) & m.tableMask;
             for (uint32_t k = m.bucketStart[b]; k < m.bucketStart[b + 1]; ++k) {
               const Impl::Entry& e = m.entries[k];
               const uint32_t j = e.j;
-              if (j <= i || e.cx != qx || e.cy != qy || e.cz != qz) continue;
-              const Vec3 d = xi - e.x;
+              if ((own && j <= i) || e.cx != qx || e.cy != qy || e.cz != qz) continue;
+              const Vec3 d = xi - e.x;  // the negative of x_j - x_i: the same squared norm
               const Real dist2 = d.squaredNorm();
               // Cheap reject first: beyond the largest margin (reach) the pair can never touch, and most
               // stencil candidates are that far; the relative speed (a square root) is read only for the rest.
@@ -176,27 +185,50 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
               const Real pairMargin = std::min(h * (v[i] - v[j]).norm() + margin_, reach);
               const Real lim = ri + r[j] + pairMargin;
               if (dist2 >= lim * lim) continue;
-              const Real dist = std::sqrt(dist2);
-              ParticleContact pc;
-              pc.a = uint32_t(i);
-              pc.b = int32_t(j);
-              // Coincident centres: any unit normal will do; pick +z so the result is deterministic.
-              pc.normal = dist > 1e-12 * (ri + r[j]) ? Vec3(d / dist) : Vec3::UnitZ();
-              pc.depth = ri + r[j] - dist;
-              // Midway between the two surfaces.
-              pc.point = xi - pc.normal * (ri - 0.5 * pc.depth);
-              out.push_back(pc);
+              out.push_back(j > i ? std::make_pair(uint32_t(i), j) : std::make_pair(j, uint32_t(i)));
             }
           }
-      // Order this particle's contacts by partner so the list does not depend on the hash layout.
-      std::sort(out.begin() + long(firstNew), out.end(),
-                [](const ParticleContact& p, const ParticleContact& q) { return p.b < q.b; });
     }
   }
-  size_t total = 0;
-  for (size_t c = 0; c < numChunks; ++c) total += m.chunkOut[c].size();
-  pp_.reserve(total);
-  for (size_t c = 0; c < numChunks; ++c) pp_.insert(pp_.end(), m.chunkOut[c].begin(), m.chunkOut[c].end());
+  // Counting sort by a, then each a's partners in ascending order.
+  m.pairStart.assign(n + 1, 0);
+  for (size_t c = 0; c < numChunks; ++c)
+    for (const auto& [a, b] : m.chunkPairs[c]) ++m.pairStart[a + 1];
+  for (size_t i = 0; i < n; ++i) m.pairStart[i + 1] += m.pairStart[i];
+  const size_t total = m.pairStart[n];
+  m.pairB.resize(total);
+  {
+    std::vector<uint32_t>& fill = m.candidates;  // reuse as a cursor array
+    fill.assign(m.pairStart.begin(), m.pairStart.end() - 1);
+    for (size_t c = 0; c < numChunks; ++c)
+      for (const auto& [a, b] : m.chunkPairs[c]) m.pairB[fill[a]++] = b;
+  }
+  pp_.resize(total);
+#pragma omp parallel for schedule(dynamic, 1) if (numChunks >= kParallelChunks)
+  for (size_t c = 0; c < numChunks; ++c) {
+    const size_t end = std::min(n, (c + 1) * kChunk);
+    for (size_t i = c * kChunk; i < end; ++i) {
+      const uint32_t k0 = m.pairStart[i], k1 = m.pairStart[i + 1];
+      if (k0 == k1) continue;
+      // Order this particle's contacts by partner so the list does not depend on the hash layout.
+      std::sort(m.pairB.begin() + k0, m.pairB.begin() + k1);
+      const Vec3 xi = x[i];
+      const Real ri = r[i];
+      for (uint32_t k = k0; k < k1; ++k) {
+        const uint32_t j = m.pairB[k];
+        const Vec3 d = xi - x[j];
+        const Real dist = std::sqrt(d.squaredNorm());
+        ParticleContact& pc = pp_[k];  // value-initialised by the resize (pp_ was cleared)
+        pc.a = uint32_t(i);
+        pc.b = int32_t(j);
+        // Coincident centres: any unit normal will do; pick +z so the result is deterministic.
+        pc.normal = dist > 1e-12 * (ri + r[j]) ? Vec3(d / dist) : Vec3::UnitZ();
+        pc.depth = ri + r[j] - dist;
+        // Midway between the two surfaces.
+        pc.point = xi - pc.normal * (ri - 0.5 * pc.depth);
+      }
+    }
+  }
 
   // ---- particles vs geometries -------------------------------------------------------------------------------
   const int nt = maxThreads();

@@ -41,7 +41,40 @@ SCREE_UNIT_INLINE inline Vec3 rollingImpulse(U& u, const Vec3& wr) {
   return T;
 }
 
-uint64_t slotKey(size_t id) { return uint64_t(uint32_t(id & 0xffffffffu)); }
+/// Warm-start key of a particle: the low 32 bits of its id (its slot, stable while it lives).
+uint64_t slotKey(const GranularBodySystem& ps, size_t dense) { return uint64_t(ps.idLowOfDense(dense)); }
+
+/// Order-preserving map of a finite height to an unsigned key (-0 is taken as +0: equal for operator<).
+uint64_t heightKey(Real h) {
+  static_assert(sizeof(Real) == sizeof(uint64_t));
+  const uint64_t u = std::bit_cast<uint64_t>(h + 0.0);  // -0 + 0 = +0
+  return (u >> 63) ? ~u : u | (uint64_t(1) << 63);
+}
+
+/// Sorts (heightKey, code) pairs pushed in increasing code order into (height, code) order, as std::sort on
+/// (height, code) did: a stable LSD radix sort (8-bit digits, a digit that all keys share is skipped), which
+/// keeps equal heights in code order. Fewer mispredicted branches than std::sort here (the shock order has
+/// 10,000-20,000 entries in the trench bench). The heights are finite (integrate stops a particle before its
+/// position turns non-finite).
+void sortByHeight(std::vector<std::pair<uint64_t, uint32_t>>& v, std::vector<std::pair<uint64_t, uint32_t>>& tmp) {
+  const size_t n = v.size();
+  if (n < 64) {
+    std::sort(v.begin(), v.end());
+    return;
+  }
+  tmp.resize(n);
+  auto* src = &v;
+  auto* dst = &tmp;
+  for (int shift = 0; shift < 64; shift += 8) {
+    uint32_t count[257] = {};
+    for (const auto& e : *src) ++count[((e.first >> shift) & 0xff) + 1];
+    if (count[(((*src)[0].first >> shift) & 0xff) + 1] == n) continue;  // all share this digit
+    for (int d = 0; d < 256; ++d) count[d + 1] += count[d];
+    for (const auto& e : *src) (*dst)[count[(e.first >> shift) & 0xff]++] = e;
+    std::swap(src, dst);
+  }
+  if (src != &v) v.swap(tmp);
+}
 
 }  // namespace
 
@@ -65,11 +98,11 @@ GranularStage::PairParams GranularStage::makeParams(const SurfaceParameters& s, 
   return p;
 }
 
-const GranularStage::CacheEntry* GranularStage::find(const std::vector<CacheEntry>& cache, uint64_t key,
-                                                     uint32_t feature) const {
-  CacheEntry probe{key, feature, 0, Vec3::Zero(), Vec3::Zero(), 0};
-  auto it = std::lower_bound(cache.begin(), cache.end(), probe);
-  if (it != cache.end() && it->key == key && it->feature == feature) return &*it;
+const GranularStage::CacheEntry* GranularStage::find(const std::vector<CacheKey>& keys,
+                                                     const std::vector<CacheEntry>& entries, uint64_t key,
+                                                     uint32_t feature) {
+  auto it = std::lower_bound(keys.begin(), keys.end(), CacheKey{key, feature, 0});
+  if (it != keys.end() && it->key == key && it->feature == feature) return &entries[it->entry];
   return nullptr;
 }
 
@@ -240,14 +273,13 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     const CacheEntry* ce = nullptr;
     Real sgn = 1.0;
     {
-      const size_t idA = ps.idOfDense(a);
       if (isPP) {
-        const uint64_t sa = slotKey(idA), sb = slotKey(ps.idOfDense(size_t(c.b)));
+        const uint64_t sa = slotKey(ps, a), sb = slotKey(ps, size_t(c.b));
         u.flip = sa > sb;
         sgn = u.flip ? -1.0 : 1.0;
-        ce = find(ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
+        ce = find(ppKeys_, ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
       } else {
-        ce = find(pgCache_, slotKey(idA) << 32 | sides[k - pp.size()].geometryId, c.featureId);
+        ce = find(pgKeys_, pgCache_, slotKey(ps, a) << 32 | sides[k - pp.size()].geometryId, c.featureId);
       }
     }
     const Real vn0 = u.n.dot(vrel);
@@ -575,20 +607,20 @@ void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyStat
     if (u.b < 0) {
       // Geometry side: only static or kinematic geometry acts as a support here (side B is never moved).
       if (u.body >= 0 && bodies[size_t(u.body)].invMass > 0) continue;
-      shockOrder_.push_back({x[u.a].dot(up) - 2 * r[u.a], k * 2 + 1});
+      shockOrder_.push_back({heightKey(x[u.a].dot(up) - 2 * r[u.a]), k * 2 + 1});
       continue;
     }
     if (std::abs(u.n.dot(up)) <= 0.3) continue;
     const Real ha = x[u.a].dot(up), hb = x[size_t(u.b)].dot(up);
     // Freeze the lower particle.
-    shockOrder_.push_back(ha < hb ? std::make_pair(ha, k * 2 + 0) : std::make_pair(hb, k * 2 + 1));
+    shockOrder_.push_back(ha < hb ? std::make_pair(heightKey(ha), k * 2 + 0) : std::make_pair(heightKey(hb), k * 2 + 1));
   }
-  std::sort(shockOrder_.begin(), shockOrder_.end());
+  sortByHeight(shockOrder_, shockScratch_);
   auto& v = ps.velocities();
   auto& w = ps.angularVelocities();
   Real unused = 0;
   for (int s = 0; s < sweeps; ++s)
-    for (const auto& [h, code] : shockOrder_) {
+    for (const auto& [key, code] : shockOrder_) {
       Unit& u = units_[code >> 1];
       if (u.centred) {
         if (code & 1) solveCentred<1>(u, v.data(), w.data(), ps.invMasses().data(), invInertia_.data(), unused);
@@ -751,8 +783,8 @@ void GranularStage::storeResults(const GranularBodySystem& ps, const ParticleCon
   auto& pg = *contacts.particleGeometry;
   const auto& sides = *contacts.geometrySides;
   const Real invH = 1.0 / h;
-  nextPp_.clear();
-  nextPg_.clear();
+  ppCache_.clear();
+  pgCache_.clear();
   for (const Unit& u : units_) {
     if (!ps.isAliveDense(u.a) || (u.b >= 0 && !ps.isAliveDense(size_t(u.b)))) continue;
     const Vec3 F = u.lT1 * u.t1 + u.lT2 * u.t2;
@@ -760,19 +792,22 @@ void GranularStage::storeResults(const GranularBodySystem& ps, const ParticleCon
     ParticleContact& c = u.b >= 0 ? pp[u.src] : pg[u.src];
     c.normalForce = u.lN * invH;
     c.frictionForce = F * invH;
-    const uint64_t sa = slotKey(ps.idOfDense(u.a));
+    const uint64_t sa = slotKey(ps, u.a);
     if (u.b >= 0) {
-      const uint64_t sb = slotKey(ps.idOfDense(size_t(u.b)));
+      const uint64_t sb = slotKey(ps, size_t(u.b));
       const Real s = u.flip ? -1.0 : 1.0;
-      nextPp_.push_back({u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0, u.lN, s * F, s * T, u.impact});
+      ppCache_.push_back({u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0, u.lN, s * F, s * T, u.impact});
     } else {
-      nextPg_.push_back({sa << 32 | sides[u.src].geometryId, c.featureId, u.lN, F, T, u.impact});
+      pgCache_.push_back({sa << 32 | sides[u.src].geometryId, c.featureId, u.lN, F, T, u.impact});
     }
   }
-  std::sort(nextPp_.begin(), nextPp_.end());
-  std::sort(nextPg_.begin(), nextPg_.end());
-  std::swap(ppCache_, nextPp_);
-  std::swap(pgCache_, nextPg_);
+  auto index = [](const std::vector<CacheEntry>& entries, std::vector<CacheKey>& keys) {
+    keys.resize(entries.size());
+    for (size_t e = 0; e < entries.size(); ++e) keys[e] = {entries[e].key, entries[e].feature, uint32_t(e)};
+    std::sort(keys.begin(), keys.end());
+  };
+  index(ppCache_, ppKeys_);
+  index(pgCache_, pgKeys_);
 }
 
 }  // namespace scree::detail

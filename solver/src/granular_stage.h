@@ -163,9 +163,20 @@ class GranularStage {
     Real normal;
     Vec3 friction, rolling;  // on the lower slot (pp) or on the particle (pg)
     Real impact;
-    bool operator<(const CacheEntry& o) const { return key != o.key ? key < o.key : feature < o.feature; }
   };
-  const CacheEntry* find(const std::vector<CacheEntry>& cache, uint64_t key, uint32_t feature) const;
+  // The warm-start caches are searched through a sorted array of 16-byte keys (a quarter of the entries'
+  // size, so the binary search stays in the cache), each pointing at its entry, stored in storeResults order.
+  struct CacheKey {
+    uint64_t key;
+    uint32_t feature;
+    uint32_t entry;  // index into the entries; the last tie break, so the order is total
+    bool operator<(const CacheKey& o) const {
+      return key != o.key ? key < o.key : feature != o.feature ? feature < o.feature : entry < o.entry;
+    }
+  };
+  /// The entry of (key, feature), the first in key order if there are several; null if none.
+  static const CacheEntry* find(const std::vector<CacheKey>& keys, const std::vector<CacheEntry>& entries,
+                                uint64_t key, uint32_t feature);
   /// One Gauss-Seidel update of unit u (normal, then friction disc, then rolling disc). kFrozen < 0: both
   /// sides move (the sweeps; |delta lambda| goes into maxDelta). kFrozen = 0 or 1: side A or B is held
   /// immovable (the shock pass), the effective masses are those of the free particle alone and rolling is
@@ -201,8 +212,10 @@ class GranularStage {
   std::vector<std::pair<std::pair<uint32_t, const Material*>, PairParams>> pgParams_;  // pairs met this step
   std::vector<uint32_t> pgParam_, pgUnit_;  // per particle-geometry contact: its pgParams_ entry and unit
   std::vector<int32_t> pgBody_;             // per particle-geometry contact: solver body, -1 none
-  std::vector<std::pair<Real, uint32_t>> shockOrder_;  // (height of the lower side, unit * 2 + frozen side)
-  std::vector<CacheEntry> ppCache_, pgCache_, nextPp_, nextPg_;
+  // (height of the lower side as an order-preserving key, unit * 2 + frozen side), and the radix sort's buffer.
+  std::vector<std::pair<uint64_t, uint32_t>> shockOrder_, shockScratch_;
+  std::vector<CacheEntry> ppCache_, pgCache_;
+  std::vector<CacheKey> ppKeys_, pgKeys_;
   // DIRECT mode, valid between appendDirectRows and finishDirect.
   size_t rowBase_ = 0, bodyBase_ = 0;  // sizes of rows / bodies before the append
   std::vector<int32_t> extBody_;       // [size()] solver body of a particle, -1 none

@@ -1,7 +1,8 @@
 // ParticleCollider: contacts of GranularBodySystem particles with each other and with geometries.
 //
 // Broadphase: a hashed uniform grid over the particles, cell size = largest particle diameter + the pair
-// margin, so every touching or speculative pair lies in the same or an adjacent cell (27-cell stencil). The
+// margin, so every touching or speculative pair lies in the same or an adjacent cell (27-cell stencil, visited
+// as a half stencil: the own cell and the 13 cells after it, so each pair of cells is met from one side). The
 // cells are built by a counting sort in dense order (deterministic); candidate pairs are found in parallel over
 // fixed chunks of particles, each chunk writing its own buffer, and the buffers are concatenated in chunk order,
 // so the contact list is the same for any number of threads. A stencil cell whose nearest point is at least one

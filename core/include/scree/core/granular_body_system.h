@@ -119,6 +119,9 @@ class GranularBodySystem {
   size_t size() const { return positions_.size(); }
   bool isAliveDense(size_t i) const { return alive_[i] != 0; }
   size_t idOfDense(size_t i) const;
+  // ---- (issue 16 performance) the low 32 bits of idOfDense(i), without reading the slot's generation: the
+  // particle solver's warm-start keys (solver/src/granular_stage.cpp) -------------------------------------------
+  uint32_t idLowOfDense(size_t i) const { return denseToSlot_[i] + 1; }
   /// Dense index of a live id; throws for an invalid id.
   size_t denseIndex(size_t id) const;
   std::vector<Vec3>& positions() { return positions_; }
