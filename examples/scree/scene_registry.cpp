@@ -207,6 +207,8 @@ std::vector<SceneEntry> makeRegistry() {
                  s->sim->getSolver().setNumIterations(16);  // as scree_demo
                  auto pile = std::make_shared<demo::GranularPile>(*s->sim, s->material);
                  s->sim->add(StepEventListenerRef(pile));
+                 // The pile sets this material at its first pour; set now, a recording lists it from the start.
+                 s->sim->getGranularBodySystem().setMaterial(pile->getGrainMaterial());
                  SceneRun r = fromScene(s, BuildOptions{});
                  r.printMetrics = [pile] {
                    std::printf("  ");

@@ -16,6 +16,8 @@
 //   - height fields: the heights of every HEIGHT_FIELD geometry, first in full, then per frame the rectangles
 //     that changed (one rectangle per 32 x 32-vertex block with a change: a rut or a trench touches a few
 //     blocks, not the grid);
+//   - particle speeds: |v| rounded to 12 significant bits and 0 below 1e-4 m/s (a resting particle's speed is
+//     solver noise that changes every bit every step: written in full it would dominate a settled pile's file);
 //   - contacts (setRecordContacts(true)): the geometry contact points and the particle contact points of the
 //     last step with their normal forces.
 //
@@ -114,7 +116,7 @@ struct RecordedFrame {
   std::vector<double> poses;              ///< 7 per body: x, y, z, qx, qy, qz, qw
   std::vector<uint32_t> particleIds;
   std::vector<float> particlePositions;   ///< 3 per particle
-  std::vector<float> particleSpeeds;      ///< m/s
+  std::vector<float> particleSpeeds;      ///< m/s (12 significant bits, 0 below 1e-4 m/s: see the writer)
   std::vector<float> particleRadii;       ///< m
   std::vector<uint16_t> particleMaterials;
   std::vector<std::vector<RecordedHeightRect>> heightRects;  ///< per height field: the rectangles that changed
