@@ -178,7 +178,6 @@ void RecordingWriter::begin(const Simulation& sim, const std::string& sceneName,
                             const std::vector<const Terrain*>& terrains) {
   if (!file_) throw std::logic_error("RecordingWriter::begin: open() first");
   State& st = *st_;
-  auto& simNc = const_cast<Simulation&>(sim);  // getMaterialManager / getGranularBodySystem: read only here
 
   // Geometries: the static ones (with the terrains' geometries not in the simulation), then the bodies'.
   std::vector<GeometryRef> statics = sim.getStaticGeometries();
@@ -285,7 +284,6 @@ void RecordingWriter::begin(const Simulation& sim, const std::string& sceneName,
   };
   for (const MaterialRef& m : ps.getMaterialTable()) addParticleMaterial(m.get());
   addParticleMaterial(ps.getMaterial().get());
-  (void)simNc;
 
   ByteWriter scene;
   scene.putString(sceneName);
