@@ -40,6 +40,9 @@ class GranularPile : public StepEventListener {
       }
   }
 
+  /// The grains' material (the particle system's material from the first pour on).
+  const MaterialRef& getGrainMaterial() const { return grain_; }
+
   /// One line: particles, pile height, kinetic energy.
   void printSummary() const {
     const GranularBodySystem& ps = sim_.getGranularBodySystem();

@@ -9,13 +9,17 @@
 // bucket digs a trench in a Terrain, lifts and dumps the soil, and the heap merges back (demo_dig.h), and a
 // dozer blade pushes soil into a berm that slumps toward its angle of repose (demo_dozer.h).
 //
-// Usage: scree_demo [seconds=5] [iterations=16]
+// Usage: scree_demo [seconds=5] [iterations=16] [--record FILE]
+//   --record FILE  also writes the first, combined scene as a recording (docs/recording.md) that
+//                  `scree view FILE` turns into a replay page; scripts/demo.sh does both.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <vector>
 
+#include <scree/io/recording.h>
 #include <scree/scree.h>
 
 #include "demo_vehicle.h"
@@ -40,8 +44,21 @@ RigidBodyRef makeBody(Simulation& sim, ShapeRef shape, const Vec3& pos, const Ma
 }  // namespace
 
 int main(int argc, char** argv) {
-  const double seconds = argc > 1 ? std::atof(argv[1]) : 5.0;
-  const int iterations = argc > 2 ? std::atoi(argv[2]) : 16;
+  std::vector<std::string> args;
+  std::string recordPath;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--record") {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "scree_demo: --record needs a file name\n");
+        return 2;
+      }
+      recordPath = argv[++i];
+    } else {
+      args.push_back(argv[i]);
+    }
+  }
+  const double seconds = args.size() > 0 ? std::atof(args[0].c_str()) : 5.0;
+  const int iterations = args.size() > 1 ? std::atoi(args[1].c_str()) : 16;
   std::printf("%s\n", getConfigurationString());
 
   Simulation sim;
@@ -133,10 +150,18 @@ int main(int argc, char** argv) {
   Real ballApex = 0;
   double solveTime = 0, totalTime = 0;
   int steps = 0;
+  // The recording (docs/recording.md) of this combined scene at 30 frames per simulated second.
+  io::RecordingWriter recorder;
+  if (!recordPath.empty()) {
+    recorder.open(recordPath);
+    recorder.setRecordEvery(std::max(1, int(std::lround(1.0 / (30.0 * sim.getTimeStep())))));
+    recorder.begin(sim, "scree_demo");
+  }
   std::printf("%5s %9s %9s %9s %9s %9s %9s %9s %9s %8s %8s\n", "t[s]", "tower[cm]", "pyr[cm]", "slide[m]", "ball[m]",
               "heavy[mm]", "pileKE[J]", "arm[rad]", "chain[mm]", "contacts", "ms/step");
   while (sim.getTimeStamp() < seconds - 1e-9) {
     sim.stepForward();
+    if (recorder.isOpen()) recorder.writeFrame(sim);
     ++steps;
     solveTime += sim.getStepStats().solve;
     totalTime += sim.getStepStats().total;
@@ -156,6 +181,11 @@ int main(int argc, char** argv) {
                   1000 * totalTime / steps);
       ballApex = 0;
     }
+  }
+  if (recorder.isOpen()) {
+    const uint32_t frames = recorder.getNumFrames();
+    const uint64_t bytes = recorder.close();
+    std::printf("recorded %u frames (%.2f MB) to %s\n", frames, bytes / 1e6, recordPath.c_str());
   }
   const Real expectedSlide = 25.0 / (2 * 0.5 * 9.81);
   std::printf("slider stopped after %.4f m (Coulomb: v^2/(2 mu g) = %.4f m)\n", slider->getPosition().x() - sliderX0,

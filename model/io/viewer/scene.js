@@ -97,6 +97,9 @@ const ScreeScene = (() => {
 
       this.materials = rec.scene.materials.map((m) => new THREE.MeshLambertMaterial({ color: srgb(m.rgb) }));
       this.defaultMaterial = new THREE.MeshLambertMaterial({ color: srgb(DEFAULT_RGB) });
+      // Static geometry (grounds, walls) in a neutral grey whatever its material: scenes often give every body
+      // the same material, and moving bodies in their material's colour must stand out against the ground.
+      this.staticMaterial = new THREE.MeshLambertMaterial({ color: srgb([150, 150, 150]) });
       this.bodies = rec.scene.bodies.map((b) => this.buildBody(b));
       this.terrains = rec.heightFields.map((hf, t) => this.buildTerrain(hf, t));
       this.buildParticles();
@@ -115,7 +118,7 @@ const ScreeScene = (() => {
       group.name = b.name;
       for (const g of b.geometries) {
         let obj = null;
-        const mat = this.material(g.material);
+        const mat = b.motion === 0 ? this.staticMaterial : this.material(g.material);
         switch (g.shape) {
           case "sphere": obj = new THREE.Mesh(new THREE.SphereGeometry(g.radius, 24, 16), mat); break;
           case "box": {
@@ -123,8 +126,8 @@ const ScreeScene = (() => {
             obj = new THREE.Mesh(new THREE.BoxGeometry(2 * x, 2 * y, 2 * z), mat);
             break;
           }
-          case "capsule": obj = new THREE.Mesh(new THREE.CapsuleGeometry(g.radius, g.height, 8, 16).rotateX(Math.PI / 2), mat); break;
-          case "cylinder": obj = new THREE.Mesh(new THREE.CylinderGeometry(g.radius, g.radius, g.height, 24).rotateX(Math.PI / 2), mat); break;
+          case "capsule": obj = new THREE.Mesh(new THREE.CapsuleGeometry(g.radius, g.height, 8, 16), mat); break;
+          case "cylinder": obj = new THREE.Mesh(new THREE.CylinderGeometry(g.radius, g.radius, g.height, 24), mat); break;
           case "plane": {
             // Points x with normal . x = offset, drawn as a 40 m square, a little transparent.
             const n = new THREE.Vector3(...g.normal).normalize();

@@ -133,6 +133,14 @@
     };
     playButton.addEventListener("click", () => setPlaying(!state.playing));
     window.addEventListener("keydown", (e) => { if (e.code === "Space") { e.preventDefault(); setPlaying(!state.playing); } });
+    // `?t=SECONDS` opens the page paused at that recording time (links to a moment, screenshots).
+    const startAt = parseFloat(new URLSearchParams(window.location.search).get("t"));
+    if (Number.isFinite(startAt)) {
+      state.frame = frameAt(Math.max(0, startAt));
+      state.clock = rec.frames[state.frame].time - t0rec;
+      setPlaying(false);
+      state.dirty = true;
+    }
     $("rate").addEventListener("change", (e) => { state.rate = parseFloat(e.target.value); });
     scrub.addEventListener("input", () => {
       state.frame = parseInt(scrub.value, 10);
