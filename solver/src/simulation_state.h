@@ -85,6 +85,11 @@ struct SimulationState {
   std::vector<PgsSolver::ShockRange> shock;
   std::vector<uint32_t> frontier;
   std::vector<std::pair<int, uint32_t>> order;
+  // Warm-start source (issue 18, solve_stage.cpp rigidShock): per row, its impulse before the rigid shock pass
+  // (the sweeps' impulse) when the row supports a body held by two or more supports in the pass, NaN otherwise;
+  // empty when no shock pass ran. storeResults caches these for next step's warm start instead of the solved ones.
+  std::vector<Real> sweepLambda;
+  std::vector<int> shockSupports;         // per solver body: shock ranges in which it is the free body
 
   // ---- position projection: its own direct solver, so each keeps its cached symbolic analysis ---------------
   DirectSolver projector;
