@@ -62,9 +62,9 @@ class Solver {
   /// different support levels are solved once more from the static ground upwards with the supporting
   /// (lower) body held immovable, so stacks and heavy-on-light supports hold at low iteration counts. It gives
   /// up exact momentum exchange between the two bodies in that pass (the support does not feel the reaction);
-  /// switch it off for the plain PGS result. A body resting on two or more supports starts next step from the
-  /// sweeps' impulses of those supports, not the pass's, whose split between them depends on the order in which
-  /// the pass visits them (docs/solver-internals.md "Resting stacks").
+  /// switch it off for the plain PGS result. Next step's warm start of those contacts is the sweeps' impulses
+  /// (plus, on a body's single support, the load the pass added, spread evenly), not the pass's: its reaction
+  /// would reach the lower body a step late and pump stacks (docs/solver-internals.md "Resting stacks").
   void setUseShockPropagation(bool on) { shock_ = on; }
   bool getUseShockPropagation() const { return shock_; }
   // ---- Contact manifolds (issue 18; docs/solver-internals.md "Resting stacks"), both on by default ----
