@@ -126,8 +126,8 @@ std::pair<Real, Real> flatBounce(int manifolds) {
 }  // namespace
 
 // At default settings (the manifold options are on by default since the shock pass stopped feeding the warm
-// start of multi-support bodies, docs/solver-internals.md "Resting stacks"). Measured 0 mm; 13.6 mm with the
-// options off: Gauss-Seidel over the four normal rows of the impact gives unequal impulses, a torque.
+// start, docs/solver-internals.md "Resting stacks"). Measured 0 mm; 13.6 mm with the options off: Gauss-Seidel
+// over the four normal rows of the impact gives unequal impulses, a torque.
 TEST_CASE("a box dropped flat with restitution 0.5 bounces straight: sideways drift under 1 mm") {
   // By symmetry nothing acts sideways, so every bounce must land where the first one did.
   const auto [maxDrift, apex] = flatBounce(-1);

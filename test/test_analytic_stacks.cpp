@@ -45,8 +45,8 @@ TEST_CASE("pyramid20 stands 10 s with every box within 1 cm (16 iterations)") {
 
 TEST_CASE("pyramid20 stands 10 s with every box within 1 cm at the scene's 10 iterations (issue 18)") {
   // The issue-18 bound at docs/scenes.md's 10 iterations. Measured 0.015 cm with the default manifold block and
-  // manifold friction (0.41 cm with both off; 2.1 cm with both on before multi-support bodies stopped taking the
-  // shock pass's impulses as their warm start, docs/solver-internals.md "Resting stacks").
+  // manifold friction (0.41 cm with both off; 2.1 cm with both on while the shock pass's impulses were the
+  // warm start, docs/solver-internals.md "Resting stacks: the shock pass and the warm start").
   PyramidScene s = buildPyramid20();
   REQUIRE(s.sim->getSolver().getNumIterations() == 10);
   const PyramidMetrics m = runPyramid(s);
