@@ -43,6 +43,32 @@ TEST_CASE("pyramid20 stands 10 s with every box within 1 cm (16 iterations)") {
   CHECK(m.maxDisplacement < kMaxDrift);
 }
 
+TEST_CASE("pyramid20 stands 10 s with every box within 1 cm at the scene's 10 iterations (issue 18)") {
+  // The issue-18 bound at docs/scenes.md's 10 iterations. Measured 0.015 cm with the default manifold block and
+  // manifold friction (0.41 cm with both off; 2.1 cm with both on while the shock pass's impulses were the
+  // warm start, docs/solver-internals.md "Resting stacks: the shock pass and the warm start").
+  PyramidScene s = buildPyramid20();
+  REQUIRE(s.sim->getSolver().getNumIterations() == 10);
+  const PyramidMetrics m = runPyramid(s);
+  MESSAGE("pyramid20, 10 iterations: largest box drift " << m.maxDisplacement * 100 << " cm, top dz "
+                                                         << m.topDz * 100 << " cm");
+  CHECK(m.finite);
+  CHECK(m.stands);
+  CHECK(m.maxDisplacement < kMaxDrift);
+}
+
+// Goal of issue 18, skipped because it does not hold (run with --no-skip; it then fails): without the shock pass
+// the sweeps alone are too weak per sweep for 20 rows at 10 iterations. Measured 58 cm of drift (the pyramid
+// sags but its top stays within 10 cm of height: "stands" holds), 10 m with the manifold options off.
+TEST_CASE("pyramid20 without the shock pass stands within 3 cm at 10 iterations" * doctest::skip()) {
+  PyramidScene s = buildPyramid20();
+  s.sim->getSolver().setUseShockPropagation(false);
+  const PyramidMetrics m = runPyramid(s);
+  MESSAGE("pyramid20, 10 iterations, no shock pass: largest box drift " << m.maxDisplacement * 100 << " cm");
+  CHECK(m.finite);
+  CHECK(m.maxDisplacement < 0.03);
+}
+
 TEST_CASE("mass_ratio: 1000 kg on 1 kg holds, heavy box within 1 cm of 1.5 m (scene's 10 iterations)") {
   // Bound 1 cm on the final and on the worst height error over the run: compliance alone sinks the heavy box
   // by (1000 + 1001) kg g / (4 E) ~ 12 micrometres; ODE's direct solver holds it 6 mm low, Bullet, Jolt and

@@ -76,10 +76,16 @@ void buildContactRows(SimulationState& s) {
                  solveType == FrictionModel::ITERATIVE;
     bool manifoldFriction = useManifoldFriction && rollMu == 0 && ftype != FrictionModel::BOX;
     Vec3 centre = zero;
+    // The normal block solves the manifold on its centre-and-tilt coordinates (pgs.cpp), which is the exact block
+    // solution only when the rows' compliances are equal: with per-point Young's moduli or damping times (the
+    // terrain's deformer contacts mix points 1000x softer than the rest) the affine load it imposes would load
+    // the soft points like the stiff ones. Such manifolds keep their rows one by one.
+    bool sameLaw = true;
     for (const ContactPoint& p : pts) {
       if (!p.enabled) continue;
       if (!first) first = &p;
       centre += p.point;
+      sameLaw = sameLaw && p.youngsModulus == first->youngsModulus && p.damping == first->damping;
       block = block && p.normal.dot(first->normal) > 1 - 1e-9;
       manifoldFriction = manifoldFriction && muOf(p) > 0 && muOf(p) == muOf(*first) &&
                          p.frictionDirection == zero && p.surfaceVelocity == first->surfaceVelocity;
@@ -177,7 +183,7 @@ void buildContactRows(SimulationState& s) {
       r.lo = nr.lo;
       r.hi = 1e300;
       r.lambda = ce ? std::max(ce->normal, r.lo) : 0.0;
-      if (block && useBlock) {
+      if (block && useBlock && sameLaw) {
         r.blockBegin = firstNormal;
         r.blockCount = int32_t(nActive);
         r.blockU = blockU[ak];

@@ -85,6 +85,11 @@ struct SimulationState {
   std::vector<PgsSolver::ShockRange> shock;
   std::vector<uint32_t> frontier;
   std::vector<std::pair<int, uint32_t>> order;
+  // Warm-start source (issue 18, solve_stage.cpp rigidShock): per contact row in the rigid shock pass, the
+  // sweeps' impulse (plus, for a single support's normal rows, an even share of the load the pass added); NaN for
+  // other rows; empty when no shock pass ran. storeResults caches these instead of the solved impulses.
+  std::vector<Real> sweepLambda;
+  std::vector<int> shockSupports;         // per solver body: shock ranges in which it is the free body
 
   // ---- position projection: its own direct solver, so each keeps its cached symbolic analysis ---------------
   DirectSolver projector;

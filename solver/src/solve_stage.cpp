@@ -13,6 +13,7 @@
 // the shock passes (Solver::setUseShockPropagation). Particle units in the manual's DIRECT mode become rows on
 // appended solver bodies for the HYBRID path (granular_stage.h) and are removed again after it.
 #include <algorithm>
+#include <limits>
 
 #include "scree/core/logger.h"
 #include "step_stages.h"
@@ -75,7 +76,54 @@ void rigidShock(SimulationState& s, bool onlyIterative) {
                               return false;
                             }),
              sh.end());
-  if (!sh.empty()) PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations());
+  if (sh.empty()) return;
+  // DESIGN (issue 18, docs/solver-internals.md "Resting stacks: the shock pass and the warm start"): next step's
+  // warm start of a contact in the shock pass is built from the impulses the sweeps left, not taken from the
+  // shock pass. The pass holds the lower body of each support immovable, so its impulse changes act on the upper
+  // body only; cached as a warm start they would act on both bodies next step, a reaction delivered one step
+  // late, and that is what pumped resting stacks:
+  //  - the split between supports: a body on two supports (every box of pyramid20 above the bottom row) is
+  //    solved support by support, and the first one solved takes the whole box, on its inner edge, the second
+  //    almost nothing. Fed back, that order-dependent split loaded one lower box's edge; the pyramid breathed
+  //    (its top box rose at 0.1 m/s at step 3) and settled with 2 cm of drift with the manifold block.
+  //  - the tilt: on a single support the pass turns the upper box to follow the lower one's rocking, and the
+  //    lower box felt the counter-torque a step late, a negative damping: a 20-box tower with mm offsets rocked
+  //    up by about 5x a second and fell after 6 s.
+  // The sweeps' impulses acted on both bodies of each row, so they are a momentum-consistent guess that the next
+  // sweeps refine. Only the load the pass added is kept, for a body on a single support, where the pass has one
+  // answer whatever the order: spread evenly over the manifold's normal rows (no tilt), it carries the weight of
+  // what rests on the body down the stack from the first sweep (without it mass_ratio's 1000 kg box rose 2 um
+  // short of its compliance sink at 5 iterations; with it, it sits at the sink at every count). Friction and
+  // multi-support contacts start from the sweeps' impulses alone. Joints are left as they were (their warm
+  // start is Constraint::storeResult's). Reported contact forces are the solved impulses, shock pass included.
+  s.sweepLambda.assign(s.rows.size(), std::numeric_limits<Real>::quiet_NaN());
+  auto freeBody = [&s](const PgsSolver::ShockRange& r) {
+    return r.frozen == 0 ? s.rows[r.begin].bodyB : s.rows[r.begin].bodyA;
+  };
+  s.shockSupports.assign(s.sb.size(), 0);
+  for (const PgsSolver::ShockRange& r : sh)
+    if (freeBody(r) >= 0) ++s.shockSupports[freeBody(r)];
+  uint32_t contactEnd = uint32_t(s.rows.size());  // contact rows come first, then constraint rows
+  for (const auto& cr : s.ranges) contactEnd = std::min(contactEnd, cr.begin);
+  for (const PgsSolver::ShockRange& r : sh) {
+    if (r.begin >= contactEnd) continue;
+    for (uint32_t i = r.begin; i < r.begin + r.count; ++i) s.sweepLambda[i] = s.rows[i].lambda;
+  }
+  PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations());
+  for (const PgsSolver::ShockRange& r : sh) {
+    if (r.begin >= contactEnd || (freeBody(r) >= 0 && s.shockSupports[freeBody(r)] > 1)) continue;
+    Real added = 0;
+    int n = 0;
+    for (uint32_t i = r.begin; i < r.begin + r.count; ++i)
+      if (!s.rows[i].friction) {
+        added += s.rows[i].lambda - s.sweepLambda[i];
+        ++n;
+      }
+    if (n == 0) continue;
+    added /= Real(n);
+    for (uint32_t i = r.begin; i < r.begin + r.count; ++i)
+      if (!s.rows[i].friction) s.sweepLambda[i] = std::max(s.sweepLambda[i] + added, s.rows[i].lo);
+  }
 }
 
 /// One direct solve of the direct set with every other row's impulse held; PGS finishes the set on failure.
@@ -173,6 +221,7 @@ void solve(SimulationState& s) {
   st.directFallback = false;
   s.directSet.clear();
   s.iterSet.clear();
+  s.sweepLambda.clear();
   if (choosePath(s) == SolvePath::NOTHING) {
     st.numIterations = 0;
     st.lastResidual = 0;

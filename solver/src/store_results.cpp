@@ -1,5 +1,7 @@
 // Store-results stage: the solved impulses become the contact points' forces and next step's warm start, the
 // constraints' results (Constraint::storeResult) and the particle contacts' forces.
+#include <cmath>
+
 #include "step_stages.h"
 
 namespace scree::detail {
@@ -7,6 +9,11 @@ namespace scree::detail {
 void storeResults(SimulationState& s) {
   const Real invH = 1.0 / s.h;
   s.warmStart.beginStore();
+  // Next step's warm start: a row's sweeps' impulse when the shock pass recorded one (s.sweepLambda), else its
+  // solved impulse (solve_stage.cpp rigidShock says why).
+  auto warmLambda = [&s](int32_t i) {
+    return size_t(i) < s.sweepLambda.size() && !std::isnan(s.sweepLambda[i]) ? s.sweepLambda[i] : s.rows[i].lambda;
+  };
   for (const PointRows& pr : s.pointRows) {
     GeometryContact& c = s.contacts[pr.contact];
     ContactPoint& p = c.points()[pr.point];
@@ -19,7 +26,10 @@ void storeResults(SimulationState& s) {
     p.normalForce = ln * invH;
     p.frictionForce = ft * invH;
     p.impactSpeed = pr.impactSpeed;
-    s.warmStart.add({contactPairKey(c), p.featureId, ln, ft, pr.impactSpeed, p.point});
+    Vec3 fw = Vec3::Zero();
+    if (pr.t1 >= 0) fw = warmLambda(pr.t1) * pr.tangent1 + warmLambda(pr.t1 + 1) * pr.tangent2;
+    if (pr.twist >= 0) fw = pr.share * fw + warmLambda(pr.twist) * pr.twistArm;
+    s.warmStart.add({contactPairKey(c), p.featureId, warmLambda(pr.normal), fw, pr.impactSpeed, p.point});
   }
   s.warmStart.commit();
   for (const auto& r : s.ranges) r.c->storeResult(s.rows.data() + r.begin, s.rowDofs.data() + r.begin, r.count, s.h);

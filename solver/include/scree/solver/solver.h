@@ -62,20 +62,25 @@ class Solver {
   /// different support levels are solved once more from the static ground upwards with the supporting
   /// (lower) body held immovable, so stacks and heavy-on-light supports hold at low iteration counts. It gives
   /// up exact momentum exchange between the two bodies in that pass (the support does not feel the reaction);
-  /// switch it off for the plain PGS result.
+  /// switch it off for the plain PGS result. Next step's warm start of those contacts is the sweeps' impulses
+  /// (plus, on a body's single support, the load the pass added, spread evenly), not the pass's: its reaction
+  /// would reach the lower body a step late and pump stacks (docs/solver-internals.md "Resting stacks").
   void setUseShockPropagation(bool on) { shock_ = on; }
   bool getUseShockPropagation() const { return shock_; }
-  // ---- Contact manifolds (issue 18; docs/solver-internals.md "Resting stacks"), both off by default ----
+  // ---- Contact manifolds (issue 18; docs/solver-internals.md "Resting stacks"), both on by default ----
   /// Friction of a contact manifold (2..16 points, one normal, one mu, iterative rows) as one tangent pair at
   /// the manifold's centre bounded by mu * sum(lambda_n) plus a twist row about the normal, instead of two
-  /// rows per point. Measured alone it helps nothing (a box dropped flat drifts 22 mm instead of 13.6 mm), so it
-  /// is off; with the normal block below it is what keeps an aligned tower's top box exactly in place.
+  /// rows per point (default on). Per-point friction rows solved one after the other push a symmetric manifold
+  /// sideways; the centre pair acts on the manifold as a whole. Alone it helps nothing (a box dropped flat
+  /// drifts 22 mm instead of 13.6 mm); with the normal block below it keeps an aligned tower's top box exactly
+  /// in place.
   void setUseManifoldFriction(bool on) { manifoldFriction_ = on; }
   bool getUseManifoldFriction() const { return manifoldFriction_; }
-  /// The normal rows of such a manifold solved as one block on its centre-and-tilt coordinates. With manifold
-  /// friction: a box dropped flat bounces straight (drift 1e-16 mm), exactly aligned towers keep zero horizontal
-  /// velocity and 65 of the 81 towers of the stack sweep stand (49 without); but pyramid20 settles with 1.9 cm
-  /// of drift at 10 iterations instead of 0.4 cm, which is why it is not the default.
+  /// The normal rows of such a manifold solved as one block on its centre-and-tilt coordinates (default on), so
+  /// that a symmetric manifold gets symmetric impulses (Gauss-Seidel over a box's four corners leaves a torque).
+  /// With manifold friction: a box dropped flat bounces straight (0 mm of drift, 13.6 mm with both off),
+  /// exactly aligned towers keep zero horizontal velocity, and pyramid20 at 10 iterations drifts 0.015 cm (0.41
+  /// with both off). Switch both off for the per-point rows of earlier versions.
   void setUseManifoldNormalBlock(bool on) { manifoldBlock_ = on; }
   bool getUseManifoldNormalBlock() const { return manifoldBlock_; }
   /// Largest number of sweeps per support level in the shock pass, >= 1. Default 16.
@@ -128,7 +133,7 @@ class Solver {
   Real restitutionThreshold_ = 0.2;
   Real maxRecovery_ = 0;
   bool shock_ = true;
-  bool manifoldFriction_ = false, manifoldBlock_ = false;  // contact manifolds (issue 18)
+  bool manifoldFriction_ = true, manifoldBlock_ = true;  // contact manifolds (issue 18), on by default
   int shockIterations_ = 16;
   DirectForm form_ = AUTO;
   int maxPivots_ = 50;
