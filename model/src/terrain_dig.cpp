@@ -122,6 +122,7 @@ struct Terrain::Shovel {
   Aabb zone;             ///< non-merge zone: box grown by one particle diameter
   Real boxLowL = 0;      ///< lowest z of the box in the field's frame
   Real loX = 0, hiX = 0, loY = 0, hiY = 0;  ///< footprint in the field's frame
+  Real cap = 0;          ///< highest a site's centre may stand above the shovel plane, along up (terrain.h)
   const RigidBody* body = nullptr;
 };
 
@@ -168,6 +169,27 @@ void Terrain::findShovels(std::vector<Shovel>& out) {
       s.boxLowL = std::min(s.boxLowL, l.z());
     }
     s.body = g.getRigidBody();
+    // The cap (terrain.h, "the cap"): the top of the shovel's body - every geometry on it, the shovel included -
+    // along up above the shovel plane, from the corners of their world boxes; a site's sphere stays below it.
+    // A bare blade (nothing a particle diameter above the plane) caps at the footprint's larger horizontal side.
+    {
+      const Vec3 planePoint = s.tipL + s.upL * s.thickness;
+      Real top = -std::numeric_limits<Real>::infinity();
+      auto addBox = [&](const Aabb& b) {
+        for (int k = 0; k < 8; ++k) {
+          const Vec3 c((k & 1) ? b.hi.x() : b.lo.x(), (k & 2) ? b.hi.y() : b.lo.y(), (k & 4) ? b.hi.z() : b.lo.z());
+          top = std::max(top, (T.applyInverse(c) - planePoint).dot(s.upL));
+        }
+      };
+      addBox(s.box);
+      if (s.body)
+        for (const GeometryRef& o : s.body->getGeometries())
+          if (o.get() != &g) {
+            o->updateTransform();
+            addBox(o->getBoundingBox());
+          }
+      s.cap = top >= 2 * r ? top - r : std::max(s.hiX - s.loX, s.hiY - s.loY);
+    }
     out.push_back(s);
   };
   for (const RigidBodyRef& b : sim.getRigidBodies())
@@ -357,7 +379,7 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
               if (!(u >= cx0 && u < cx1 && w >= cy0 && w < cy1)) continue;
               const Vec3 p(x0 + u, y0 + w, (Real(kz) + b[2]) * a);
               const Real above = (p - planePoint).dot(s.upL);
-              if (!(above >= r) || !(p.z() >= h + r)) continue;
+              if (!(above >= r) || !(above <= s.cap) || !(p.z() >= h + r)) continue;
               // Clear of the ground around it: r above the highest corner of the cell holding the site (a site
               // in a cut column next to uncut ground would otherwise start inside the slope and fall through).
               {

@@ -271,7 +271,20 @@
 // over the digging shovel's footprint (its bounding box seen from above), at least r above the shovel plane (the cutting plane moved up by
 // the blade thickness, |up|), at least r above the vertex's height, and no terrain particle is closer than d.
 // The lowest free sites (nearest the shovel plane) fill first. Pending volume outside a digging shovel's
-// footprint stays pending. The particle's material is a new material with the vertex material's surface
+// footprint stays pending.
+// The cap (issue 16: a full bucket grew a column of new particles over its front edge). A site's centre stands
+// at most `top - r` above the shovel plane, where top is the highest point of the shovel's body - every geometry
+// on it, the shovel included (a bucket's back and side plates) - along up, taken from the corners of their world
+// bounding boxes: a made particle lies below the bucket's rim. A bare blade (nothing on its body reaches 2r above
+// the shovel plane: no rim to fill to) caps at its footprint's larger horizontal side instead, the height the
+// fill read-out also allows above it (TerrainShovelStats). Once a vertex's sites below the cap are taken, its
+// pending volume stays pending: the cut goes on, so a full bucket dragged on leaves a trench whose soil waits in
+// the ledger's pending account (at the vertices it passed: getVolumeLedger().pending) and becomes particles when
+// a shovel with free sites passes over it again. Why pending and not "stop cutting": the cut then keeps its
+// geometry - the lead, which keeps the uncut wall a particle diameter clear of the edge; a full bucket that
+// stopped cutting would push its edge into that wall, the jam whose forces grew with the solver's iterations
+// (above) - and the ledger stays exact with no new transfer (pending -> heightField). The cost: soil a full
+// bucket cuts is not shown as soil (no berm in front of it) until something digs there again. The particle's material is a new material with the vertex material's surface
 // parameters and a density chosen so that its mass is exactly the bulk density (the vertex material's density)
 // x V; a contact material of it with itself gives particle-particle contacts the vertex material's parameters
 // and the adhesion (the index's particleAdhesion, rest overlap r(sqrt2 - 1); with particle adhesion 0 a
