@@ -155,6 +155,9 @@ int main(int argc, char** argv) {
   if (!recordPath.empty()) {
     recorder.open(recordPath);
     recorder.setRecordEvery(std::max(1, int(std::lround(1.0 / (30.0 * sim.getTimeStep())))));
+    // The pile's grain is the particle system's material before the first grain exists, so that the recording
+    // lists it (a material first used later is recorded as unknown).
+    sim.getGranularBodySystem().setMaterial(granularPile->getGrainMaterial());
     recorder.begin(sim, "scree_demo");
   }
   std::printf("%5s %9s %9s %9s %9s %9s %9s %9s %9s %8s %8s\n", "t[s]", "tower[cm]", "pyr[cm]", "slide[m]", "ball[m]",
