@@ -3,6 +3,8 @@
 // (SCREE_HAVE_VIEWER_PAGE).
 #include "scree/io/viewer_page.h"
 
+#include "markup.h"
+
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -54,20 +56,6 @@ std::string base64(const std::vector<uint8_t>& in) {
   return out;
 }
 
-std::string htmlEscape(std::string_view s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -94,7 +82,7 @@ void writeViewerPage(const std::string& recordingPath, const std::string& htmlPa
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) detail::throwInvalid(where, "htmlPath", htmlPath, "cannot be opened for writing");
-    out << page.substr(0, title) << htmlEscape(name)
+    out << page.substr(0, title) << markupEscape(name)
         << page.substr(title + kTitleMarker.size(), rec - title - kTitleMarker.size()) << base64(bytes)
         << page.substr(rec + kRecordingMarker.size());
     out.flush();

@@ -1,6 +1,8 @@
 // VtkExporter (scree/io/vtk_export.h): hand-written VTK XML writers, binary appended (raw), and the .pvd.
 #include "scree/io/vtk_export.h"
 
+#include "markup.h"
+
 #include <algorithm>
 #include <bit>
 #include <charconv>
@@ -52,20 +54,6 @@ std::string num(double v) {
   return std::string(buf, r.ptr);
 }
 
-std::string xmlEscape(std::string_view s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 /// One VTK XML data file: the XML of the dataset element's content plus the appended raw block.
 class XmlFile {
@@ -85,7 +73,7 @@ class XmlFile {
     std::string e = "<DataArray type=\"";
     e += vtkType<T>();
     e += '"';
-    if (!name.empty()) e += " Name=\"" + xmlEscape(name) + "\"";
+    if (!name.empty()) e += " Name=\"" + markupEscape(name) + "\"";
     if (numComponents != 1) e += " NumberOfComponents=\"" + std::to_string(numComponents) + "\"";
     e += " format=\"appended\" offset=\"" + std::to_string(data_.size()) + "\"/>";
     line(indent, e);
@@ -594,7 +582,7 @@ void VtkExporter::close() {
   for (const Frame& fr : frames_)
     for (size_t i = 0; i < fr.files.size(); ++i)
       xml += "    <DataSet timestep=\"" + num(fr.time) + "\" group=\"\" part=\"" + std::to_string(fr.parts[i]) +
-             "\" file=\"" + xmlEscape(fr.files[i]) + "\"/>\n";
+             "\" file=\"" + markupEscape(fr.files[i]) + "\"/>\n";
   xml += "  </Collection>\n</VTKFile>\n";
   XmlFile::writeAtomically(fs::path(getCollectionPath()), {xml}, {}, "");
   closed_ = true;
