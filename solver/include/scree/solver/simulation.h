@@ -96,6 +96,29 @@ struct StepTimings {
            pre + applyForces + contactRows + constraintRows + particleRows + solve + integrateMotion +
            storeResults + projectPositions + checkFinite + post + compactParticles;
   }
+  /// Adds `o` field by field (every stage and `total`), for accumulating timings over steps.
+  StepTimings& operator+=(const StepTimings& o) {
+    preCollide += o.preCollide;
+    syncGeometries += o.syncGeometries;
+    collideGeometries += o.collideGeometries;
+    collideParticles += o.collideParticles;
+    resolveMaterials += o.resolveMaterials;
+    contactEvents += o.contactEvents;
+    pre += o.pre;
+    applyForces += o.applyForces;
+    contactRows += o.contactRows;
+    constraintRows += o.constraintRows;
+    particleRows += o.particleRows;
+    solve += o.solve;
+    integrateMotion += o.integrateMotion;
+    storeResults += o.storeResults;
+    projectPositions += o.projectPositions;
+    checkFinite += o.checkFinite;
+    post += o.post;
+    compactParticles += o.compactParticles;
+    total += o.total;
+    return *this;
+  }
 };
 
 /// Problems found in the last step.
