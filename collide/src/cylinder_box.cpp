@@ -1,5 +1,7 @@
-// Cylinder-box: a cylinder cap lying on a box face gets a full manifold; every other configuration keeps the
-// single libccd point (ccd_adapter.cpp).
+// Cylinder-box: a cylinder cap lying on a box face gets a full manifold (this analytic path: exact disc-rectangle
+// candidates, faster than clipping the cap polygon); every other configuration goes through the support-feature
+// manifold (convex_manifold.cpp: a cylinder lying on a face gets its side line clipped to the face), else keeps
+// the single libccd point (ccd_adapter.cpp).
 //
 // Why: a single MPR point per step lets a cylinder standing on a box rock from rim point to rim point, and a
 // suction cup (a short cylinder) pressed against a box could not hold the box level. When libccd's normal lies
@@ -22,6 +24,16 @@ int collideCylinderBox(const Shape& s0, const Transform& t0, const Shape& s1, co
   const int n = collideCcd(s0, t0, s1, t1, margin, out);
   if (n != 1) return n;
   const ContactPoint single = out.back();
+  // Every other configuration (a wheel lying on a face, a tilted cylinder on an edge): the support-feature
+  // manifold (convex_manifold.cpp), else the single point.
+  auto generic = [&]() {
+    out.pop_back();
+    const int m = manifoldFromNormal(s0, t0, s1, t1, single.normal, margin, out);
+    if (m > 0) return m;
+    out.resize(begin);
+    out.push_back(single);
+    return 1;
+  };
 
   const auto& cyl = static_cast<const Cylinder&>(s0);
   const Vec3& he = static_cast<const Box&>(s1).getHalfExtents();
@@ -33,12 +45,12 @@ int collideCylinderBox(const Shape& s0, const Transform& t0, const Shape& s1, co
   for (int i = 1; i < 3; ++i)
     if (std::abs(nl[i]) > std::abs(nl[axis])) axis = i;
   const Real kParallel = std::cos(Real(0.045));
-  if (std::abs(nl[axis]) < kParallel) return n;
+  if (std::abs(nl[axis]) < kParallel) return generic();
   const Real sgn = nl[axis] > 0 ? 1 : -1;
   const Vec3 fnLocal = Vec3::Unit(axis) * sgn;
   const Vec3 fn = t1.rotate(fnLocal);
   const Real wn = w.dot(fn);
-  if (std::abs(wn) < kParallel) return n;
+  if (std::abs(wn) < kParallel) return generic();
 
   // Cap facing the box (its outward normal is about -fn) and the face plane fn . x = faceOffset.
   const Vec3 cc = t0.p - (wn > 0 ? 1 : -1) * hh * w;

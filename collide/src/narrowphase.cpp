@@ -678,12 +678,12 @@ const Table& table() {
     add(S::CAPSULE, S::BOX, capsuleBox);
     add(S::CAPSULE, S::CAPSULE, capsuleCapsule);
     add(S::CAPSULE, S::PLANE, capsulePlane);
-    add(S::CAPSULE, S::CYLINDER, collideCcd);
-    add(S::CAPSULE, S::CONVEX, collideCcd);
+    add(S::CAPSULE, S::CYLINDER, collideCcdManifold);
+    add(S::CAPSULE, S::CONVEX, collideCcdManifold);
     add(S::CAPSULE, S::HEIGHT_FIELD, collideCapsuleHeightField);
-    add(S::CYLINDER, S::CYLINDER, collideCcd);
+    add(S::CYLINDER, S::CYLINDER, collideCcdManifold);
     add(S::CYLINDER, S::PLANE, cylinderPlane);
-    add(S::CYLINDER, S::CONVEX, collideCcd);
+    add(S::CYLINDER, S::CONVEX, collideCcdManifold);
     add(S::CYLINDER, S::HEIGHT_FIELD, collideCylinderHeightField);
     add(S::CONVEX, S::CONVEX, collideConvexConvex);
     add(S::CONVEX, S::BOX, collideConvexBox);

@@ -127,6 +127,18 @@ int collideCcd(const Shape&, const Transform&, const Shape&, const Transform&, R
 int collideCylinderBox(const Shape&, const Transform&, const Shape&, const Transform&, Real,
                        std::vector<ContactPoint>&);
 
+// --- support-feature manifolds (convex_manifold.cpp) ---------------------------------------------------------
+
+/// Given the penetration normal n (from shape 1 towards shape 0) of two convex shapes, builds the manifold from
+/// the two supporting features along it (face/cap polygon, segment, point), clipped against each other and
+/// reduced to at most 4 points. Returns 0 (appending nothing) when either feature is a point or the features do
+/// not overlap; the caller then keeps its single point.
+int manifoldFromNormal(const Shape& s0, const Transform& t0, const Shape& s1, const Transform& t1, const Vec3& n,
+                       Real margin, std::vector<ContactPoint>& out);
+/// collideCcd, then manifoldFromNormal along its normal (the single point when no manifold results).
+int collideCcdManifold(const Shape&, const Transform&, const Shape&, const Transform&, Real,
+                       std::vector<ContactPoint>&);
+
 /// Shape vs height field: the normal points out of the height field (from shape 1 towards shape 0).
 int collideSphereHeightField(const Shape&, const Transform&, const Shape&, const Transform&, Real,
                              std::vector<ContactPoint>&);

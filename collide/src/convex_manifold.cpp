@@ -1,0 +1,357 @@
+// Contact manifolds for every convex pair from one penetration normal (narrowphase_internal.h,
+// "support-feature manifolds"; docs/design.md "Contact manifolds for every convex pair").
+//
+// Why: libccd (and any single-point query) returns the deepest point only. A body resting on a flat feature of
+// another (a can on a shelf, a hull on a cylinder's cap, a wheel on a ramp) then gets one point per step that jumps
+// from rim point to rim point, and it rocks, tilts and creeps. Boxes stand because box-box clips faces; this file
+// does the same for every pair once the normal is known.
+//
+// Method (the normal n points from shape 1 towards shape 0, so shape 0's surface facing shape 1 is along -n):
+//  1. Each shape's supporting feature along its outward direction (-n for shape 0, +n for shape 1), decided with
+//     one angle tolerance kFeatureAngle (~2.6 deg, as cylinder-plane and cylinder-box use):
+//       sphere: its point; box: a face (within the tolerance of a face normal), else an edge (direction within the
+//       tolerance of perpendicular to an edge), else a vertex; capsule: its segment shifted by r along the
+//       direction when the axis is perpendicular within the tolerance, else an end point; cylinder: its cap as a
+//       regular polygon when the axis is parallel, its side line (segment) when perpendicular, else its support
+//       point; convex hull: its best-aligned face within the tolerance, else its support vertex.
+//     The cap polygon's point count follows a tolerance: N is the smallest multiple of 4 whose chord sagitta
+//     r (1 - cos(pi / N)) is at most kCapSagitta r (1 %), clamped to [8, 32]; its vertices lie on the rim at
+//     fixed angles in the cylinder frame, so they are material points (stable ids, exact rim positions).
+//  2. A point on either side: no manifold (the caller keeps its single point, which is exact for curved
+//     contact). Otherwise the reference feature is a polygon: the one whose normal is best aligned with n (ties
+//     within 1e-3 go to the larger area, then to shape 1, so the choice does not flip at rest). The contact
+//     normal is snapped to the reference face's normal and the incident feature is taken again along it, so a
+//     face contact has the face's exact normal (no MPR/EPA noise). The incident polygon or segment is clipped by
+//     the reference polygon's side planes (Sutherland-Hodgman, clipToReference); each clipped point's depth is its
+//     distance below the reference plane; points more than `margin` above it are dropped. Two segments (parallel
+//     capsules or cylinders lying side by side) clip shape 0's segment by the end planes of shape 1's; crossed
+//     segments keep the single point.
+//  3. Reduction: at most 4 points, the deepest, then the farthest from it, then the two spanning the largest
+//     signed area on either side of that segment (reduceManifold), so the kept quadrilateral spans the contact
+//     area and the centre of pressure can sit anywhere in it.
+//
+// Feature ids: (hash of reference side, feature id of shape 0, feature id of shape 1) in bits 14..30, the clip
+// label of the point in bits 0..13 (ClipVertex labels: incident edge k = k, reference side plane k = 64 + k; for a
+// segment, its end e = e). Shape feature ids: box face f = f, edge 8 + 4 axis + sign bits; cylinder cap 0/1, side
+// 2; capsule segment 1; hull face index. All are fixed in the shape's frame, so the same touching features give
+// the same ids step after step (warm starting, contact_rows.h; its position fallback covers roundoff).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "narrowphase_internal.h"
+
+namespace scree::detail {
+
+namespace {
+
+constexpr Real kFeatureAngle = 0.045;  // rad: sin and 1 - cos tolerances below
+constexpr Real kCapSagitta = 0.01;     // cap polygon: chord sagitta / r
+constexpr int kMaxFeaturePoints = 64;
+
+/// A supporting feature in world coordinates: 1 point, 2 (segment) or >= 3 (polygon counter-clockwise about
+/// `normal`, its outward face normal).
+struct Feature {
+  int count = 0;
+  Vec3 normal = Vec3::Zero();
+  uint32_t id = 0;
+  Real area = 0;
+  std::array<Vec3, kMaxFeaturePoints> p;
+};
+
+uint32_t hashIds(uint32_t a, uint32_t b) {
+  uint32_t h = a * 0x9E3779B1u ^ (b + 0x7F4A7C15u + (a << 6) + (a >> 2));
+  h ^= h >> 16;
+  h *= 0x85EBCA6Bu;
+  h ^= h >> 13;
+  h *= 0xC2B2AE35u;
+  h ^= h >> 16;
+  return h;
+}
+
+Real polygonArea(const Feature& f) {
+  Vec3 s = Vec3::Zero();
+  for (int k = 0; k < f.count; ++k) s += f.p[size_t(k)].cross(f.p[size_t((k + 1) % f.count)]);
+  return Real(0.5) * std::abs(s.dot(f.normal));
+}
+
+/// Number of cap polygon points for the sagitta tolerance (multiple of 4 in [8, 32]).
+int capPoints() {
+  static const int n = [] {
+    const Real half = std::acos(1 - kCapSagitta);  // pi / N at the tolerance
+    int m = int(std::ceil(Real(3.14159265358979323846) / half));
+    m = (m + 3) / 4 * 4;
+    return std::clamp(m, 8, 32);
+  }();
+  return n;
+}
+
+/// Supporting feature of shape s (placed by t) along the unit world direction d (outward from s).
+void supportFeature(const Shape& s, const Transform& t, const Vec3& d, Feature& f) {
+  const Real sinTol = std::sin(kFeatureAngle), cosTol = std::cos(kFeatureAngle);
+  f.count = 0;
+  f.area = 0;
+  f.normal = d;
+  switch (s.getType()) {
+    case Shape::BOX: {
+      const Vec3& h = static_cast<const Box&>(s).getHalfExtents();
+      const Vec3 dl = t.rotateInverse(d);
+      int ax = 0;
+      for (int i = 1; i < 3; ++i)
+        if (std::abs(dl[i]) > std::abs(dl[ax])) ax = i;
+      if (std::abs(dl[ax]) >= cosTol) {
+        // Face: counter-clockwise about its outward normal.
+        const Real sg = dl[ax] > 0 ? 1 : -1;
+        const int u = (ax + 1) % 3, v = (ax + 2) % 3;
+        const Real cu[4] = {-1, 1, 1, -1}, cv[4] = {-1, -1, 1, 1};
+        for (int k = 0; k < 4; ++k) {
+          Vec3 q;
+          q[ax] = sg * h[ax];
+          // (u, v, ax) is right-handed: going (-,-),(+,-),(+,+),(-,+) in (u, v) is counter-clockwise about +ax.
+          q[u] = cu[k] * h[u] * sg;
+          q[v] = cv[k] * h[v];
+          f.p[size_t(k)] = t.apply(q);
+        }
+        f.count = 4;
+        f.normal = t.rotate(Vec3::Unit(ax) * sg);
+        f.id = uint32_t(2 * ax + (sg > 0 ? 0 : 1));
+        f.area = 4 * h[u] * h[v];
+        return;
+      }
+      int e = 0;
+      for (int i = 1; i < 3; ++i)
+        if (std::abs(dl[i]) < std::abs(dl[e])) e = i;
+      Vec3 q;
+      uint32_t bits = 0;
+      for (int i = 0; i < 3; ++i) {
+        q[i] = dl[i] >= 0 ? h[i] : -h[i];
+        bits |= (dl[i] >= 0 ? 1u : 0u) << i;
+      }
+      if (std::abs(dl[e]) <= sinTol) {
+        Vec3 q0 = q, q1 = q;
+        q0[e] = -h[e];
+        q1[e] = h[e];
+        f.p[0] = t.apply(q0);
+        f.p[1] = t.apply(q1);
+        f.count = 2;
+        f.id = 8 + 8 * uint32_t(e) + (bits & ~(1u << e));
+        return;
+      }
+      f.p[0] = t.apply(q);
+      f.count = 1;
+      f.id = 64 + bits;
+      return;
+    }
+    case Shape::CYLINDER: {
+      const auto& c = static_cast<const Cylinder&>(s);
+      const Real r = c.getRadius(), hh = Real(0.5) * c.getHeight();
+      const Vec3 dl = t.rotateInverse(d);
+      if (std::abs(dl.y()) >= cosTol) {
+        const Real sg = dl.y() > 0 ? 1 : -1;
+        const int n = capPoints();
+        for (int k = 0; k < n; ++k) {
+          // Counter-clockwise about +y runs from +z towards +x: angle a at (sin a, ., cos a); about -y reversed.
+          const Real a = Real(2 * 3.14159265358979323846) * Real(k) / Real(n);
+          f.p[size_t(k)] = t.apply(Vec3(sg * r * std::sin(a), sg * hh, r * std::cos(a)));
+        }
+        f.count = n;
+        f.normal = t.rotate(Vec3(0, sg, 0));
+        f.id = sg > 0 ? 1 : 0;
+        f.area = Real(0.5) * n * r * r * std::sin(Real(2 * 3.14159265358979323846) / n);
+        return;
+      }
+      const Vec3 radial(dl.x(), 0, dl.z());
+      const Real rl = radial.norm();
+      if (std::abs(dl.y()) <= sinTol && rl > 0) {
+        const Vec3 u = radial / rl * r;
+        f.p[0] = t.apply(Vec3(u.x(), -hh, u.z()));
+        f.p[1] = t.apply(Vec3(u.x(), hh, u.z()));
+        f.count = 2;
+        f.id = 2;
+        return;
+      }
+      f.p[0] = t.apply(s.support(dl));
+      f.count = 1;
+      f.id = 3;
+      return;
+    }
+    case Shape::CAPSULE: {
+      const auto& c = static_cast<const Capsule&>(s);
+      const Real r = c.getRadius(), hh = Real(0.5) * c.getHeight();
+      const Vec3 w = t.rotate(Vec3::UnitY());
+      const Real wd = w.dot(d);
+      if (std::abs(wd) <= sinTol) {
+        f.p[0] = t.p - hh * w + r * d;
+        f.p[1] = t.p + hh * w + r * d;
+        f.count = 2;
+        f.id = 1;
+        return;
+      }
+      f.p[0] = t.p + (wd > 0 ? hh : -hh) * w + r * d;
+      f.count = 1;
+      f.id = wd > 0 ? 3 : 2;
+      return;
+    }
+    case Shape::CONVEX: {
+      const auto& c = static_cast<const Convex&>(s);
+      const Vec3 dl = t.rotateInverse(d);
+      const auto& faces = c.getFaces();
+      int best = -1;
+      Real bestDot = cosTol;
+      for (size_t k = 0; k < faces.size(); ++k) {
+        const Real x = faces[k].normal.dot(dl);
+        if (x >= bestDot) {
+          bestDot = x;
+          best = int(k);
+        }
+      }
+      if (best >= 0 && faces[size_t(best)].vertices.size() <= size_t(kMaxFeaturePoints)) {
+        const auto& F = faces[size_t(best)];
+        for (size_t k = 0; k < F.vertices.size(); ++k) f.p[k] = t.apply(c.getVertices()[F.vertices[k]]);
+        f.count = int(F.vertices.size());
+        f.normal = t.rotate(F.normal);
+        f.id = uint32_t(best);
+        f.area = polygonArea(f);
+        return;
+      }
+      f.p[0] = t.apply(s.support(dl));
+      f.count = 1;
+      f.id = 0xFFFFu;
+      return;
+    }
+    default:  // sphere (and anything else with a support point)
+      f.p[0] = t.apply(s.support(t.rotateInverse(d)));
+      f.count = 1;
+      f.id = 0;
+      return;
+  }
+}
+
+/// Clips segment a-b by the side planes of reference polygon `ref` (counter-clockwise about nRef). Returns false
+/// when nothing remains; labels: the original end (0, 1) or 64 + side plane.
+bool clipSegment(Vec3& a, Vec3& b, uint8_t& la, uint8_t& lb, const Vec3* ref, int n, const Vec3& nRef) {
+  for (int k = 0; k < n; ++k) {
+    const Vec3& r0 = ref[k];
+    const Vec3 sn = (ref[(k + 1) % n] - r0).cross(nRef);
+    const Real so = sn.dot(r0);
+    const Real da = sn.dot(a) - so, db = sn.dot(b) - so;
+    if (da > 0 && db > 0) return false;
+    const uint8_t label = uint8_t(64 + (k & 63));
+    if (da > 0) {
+      a = a + (da / (da - db)) * (b - a);
+      la = label;
+    } else if (db > 0) {
+      b = b + (db / (db - da)) * (a - b);
+      lb = label;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+int manifoldFromNormal(const Shape& s0, const Transform& t0, const Shape& s1, const Transform& t1, const Vec3& n,
+                       Real margin, std::vector<ContactPoint>& out) {
+  thread_local Feature fa, fb;
+  supportFeature(s0, t0, -n, fa);
+  if (fa.count < 2) return 0;
+  supportFeature(s1, t1, n, fb);
+  if (fb.count < 2) return 0;
+  const size_t begin = out.size();
+
+  if (fa.count == 2 && fb.count == 2) {
+    // Two segments: parallel within the tolerance, else one crossing point (the caller's).
+    const Vec3 ua = (fa.p[1] - fa.p[0]).normalized(), ub = (fb.p[1] - fb.p[0]).normalized();
+    if (ua.cross(ub).norm() > std::sin(kFeatureAngle)) return 0;
+    Vec3 a = fa.p[0], b = fa.p[1];
+    uint8_t la = 0, lb = 1;
+    // End planes of segment B: x . ub >= p0 . ub and x . ub <= p1 . ub.
+    const Real lo = ub.dot(fb.p[0]), hi = ub.dot(fb.p[1]);
+    auto clipPlane = [&](const Vec3& sn, Real so, uint8_t label) {
+      const Real da = sn.dot(a) - so, db = sn.dot(b) - so;
+      if (da > 0 && db > 0) return false;
+      if (da > 0) {
+        a = a + (da / (da - db)) * (b - a);
+        la = label;
+      } else if (db > 0) {
+        b = b + (db / (db - da)) * (a - b);
+        lb = label;
+      }
+      return true;
+    };
+    if (!clipPlane(-ub, -lo, 64) || !clipPlane(ub, hi, 65)) return 0;
+    const uint32_t base = hashIds(hashIds(2, fa.id), fb.id) & 0x7FFFC000u;
+    const Vec3 pts[2] = {a, b};
+    const uint8_t labels[2] = {la, lb};
+    for (int k = 0; k < 2; ++k) {
+      const Vec3& p = pts[k];
+      const Vec3 q = fb.p[0] + ub * ub.dot(p - fb.p[0]);  // B's point beside p
+      const Real sep = n.dot(p - q);
+      const Vec3 x = Real(0.5) * (p + q);
+      if (sep > margin || nearExisting(out, begin, x)) continue;
+      out.push_back(makeContact(x, n, -sep, base | (uint32_t(k) << 7) | labels[k]));
+    }
+    return int(out.size() - begin);
+  }
+
+  // Reference polygon: best aligned with n; ties to the larger face, then to shape 1.
+  bool refIsB;
+  if (fa.count < 3) {
+    refIsB = true;
+  } else if (fb.count < 3) {
+    refIsB = false;
+  } else {
+    const Real aa = -fa.normal.dot(n), ab = fb.normal.dot(n);
+    if (std::abs(aa - ab) <= Real(1e-3))
+      refIsB = fb.area * Real(1.05) >= fa.area;
+    else
+      refIsB = ab > aa;
+  }
+  const Feature& R = refIsB ? fb : fa;
+  Feature& I = refIsB ? fa : fb;
+  const Vec3 nRef = R.normal;  // outward from the reference shape towards the incident one
+  // Incident feature again along the exact face normal.
+  if (refIsB)
+    supportFeature(s0, t0, -nRef, I);
+  else
+    supportFeature(s1, t1, -nRef, I);
+  if (I.count < 2) return 0;
+  const Real refOffset = nRef.dot(R.p[0]);
+  const Vec3 normal = refIsB ? nRef : Vec3(-nRef);
+  const uint32_t base = hashIds(hashIds(uint32_t(refIsB), fa.id), fb.id) & 0x7FFFC000u;
+  auto emit = [&](const Vec3& p, uint32_t label) {
+    const Real sep = nRef.dot(p) - refOffset;
+    const Vec3 x = p - nRef * (Real(0.5) * sep);
+    if (sep > margin || nearExisting(out, begin, x)) return;
+    out.push_back(makeContact(x, normal, -sep, base | label));
+  };
+  if (I.count == 2) {
+    Vec3 a = I.p[0], b = I.p[1];
+    uint8_t la = 0, lb = 1;
+    if (!clipSegment(a, b, la, lb, R.p.data(), R.count, nRef)) return 0;
+    emit(a, (0u << 7) | la);
+    emit(b, (1u << 7) | lb);
+    return int(out.size() - begin);
+  }
+  thread_local std::vector<ClipVertex> poly, scratch;
+  initIncident(I.p.data(), I.count, poly);
+  clipToReference(poly, R.p.data(), R.count, nRef, scratch);
+  for (const ClipVertex& v : poly) emit(v.p, clipLabel(v));
+  return reduceManifold(out, begin, 4);
+}
+
+int collideCcdManifold(const Shape& s0, const Transform& t0, const Shape& s1, const Transform& t1, Real margin,
+                       std::vector<ContactPoint>& out) {
+  const size_t begin = out.size();
+  if (collideCcd(s0, t0, s1, t1, margin, out) != 1) return int(out.size() - begin);
+  const ContactPoint single = out.back();
+  out.pop_back();
+  const int m = manifoldFromNormal(s0, t0, s1, t1, single.normal, margin, out);
+  if (m > 0) return m;
+  out.resize(begin);
+  out.push_back(single);
+  return 1;
+}
+
+}  // namespace scree::detail
