@@ -14,7 +14,9 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <scree/scree.h>
@@ -126,24 +128,36 @@ void BM_convex_box(benchmark::State& s) { runPair(s, hull(0.25), 0.25, I, cube(0
 
 }  // namespace
 
-BENCHMARK(BM_box_box);
-BENCHMARK(BM_box_box_edge);
-BENCHMARK(BM_box_plane);
-BENCHMARK(BM_sphere_sphere);
-BENCHMARK(BM_sphere_box);
-BENCHMARK(BM_sphere_convex);
-BENCHMARK(BM_capsule_capsule);
-BENCHMARK(BM_capsule_box);
-BENCHMARK(BM_capsule_convex);
-BENCHMARK(BM_capsule_cylinder);
-BENCHMARK(BM_cylinder_box_cap);
-BENCHMARK(BM_cylinder_box_side);
-BENCHMARK(BM_cylinder_plane);
-BENCHMARK(BM_cylinder_cylinder_cap);
-BENCHMARK(BM_cylinder_cylinder_side);
-BENCHMARK(BM_cylinder_convex_cap);
-BENCHMARK(BM_convex_cylinder_cap);
-BENCHMARK(BM_convex_convex);
-BENCHMARK(BM_convex_box);
-
-BENCHMARK_MAIN();
+// SCREE_NP_ITERATIONS=N fixes every case's iteration count, so that instruction counts (valgrind --tool=callgrind,
+// N = 1 and N = 2001, difference / 2000) compare builds on a loaded machine where wall times do not.
+int main(int argc, char** argv) {
+  const std::pair<const char*, void (*)(benchmark::State&)> cases[] = {
+      {"box_box", BM_box_box},
+      {"box_box_edge", BM_box_box_edge},
+      {"box_plane", BM_box_plane},
+      {"sphere_sphere", BM_sphere_sphere},
+      {"sphere_box", BM_sphere_box},
+      {"sphere_convex", BM_sphere_convex},
+      {"capsule_capsule", BM_capsule_capsule},
+      {"capsule_box", BM_capsule_box},
+      {"capsule_convex", BM_capsule_convex},
+      {"capsule_cylinder", BM_capsule_cylinder},
+      {"cylinder_box_cap", BM_cylinder_box_cap},
+      {"cylinder_box_side", BM_cylinder_box_side},
+      {"cylinder_plane", BM_cylinder_plane},
+      {"cylinder_cylinder_cap", BM_cylinder_cylinder_cap},
+      {"cylinder_cylinder_side", BM_cylinder_cylinder_side},
+      {"cylinder_convex_cap", BM_cylinder_convex_cap},
+      {"convex_cylinder_cap", BM_convex_cylinder_cap},
+      {"convex_convex", BM_convex_convex},
+      {"convex_box", BM_convex_box},
+  };
+  const char* fixed = std::getenv("SCREE_NP_ITERATIONS");
+  for (const auto& [name, fn] : cases) {
+    auto* b = benchmark::RegisterBenchmark(name, fn);
+    if (fixed) b->Iterations(std::atoll(fixed));
+  }
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  return 0;
+}

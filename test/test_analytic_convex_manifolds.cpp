@@ -8,6 +8,7 @@
 // Young's modulus 4e8 N/m spring under a few hundred newtons), so anything near 1 cm is rocking or creeping.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -162,6 +163,85 @@ constexpr Real kDropPerBody = 0.002;
 }  // namespace
 
 TEST_SUITE("convex manifolds") {
+
+TEST_CASE("narrowphase: manifolds from the supporting features, exact depths, persistent feature ids") {
+  auto place = [](const ShapeRef& s, const Vec3& p, const Quat& q) {
+    auto g = std::make_shared<Geometry>(s);
+    g->setRotation(q);
+    g->setPosition(p);
+    return g;
+  };
+  auto ids = [](const std::vector<ContactPoint>& c) {
+    std::vector<uint32_t> v;
+    for (const auto& p : c) v.push_back(p.featureId);
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  const Real r = 0.2, hh = 0.2, tilt = 0.02;
+  SUBCASE("a cylinder tilted 0.02 rad on a wider cylinder's cap: 4 points, the deepest one exact") {
+    // Below: r 0.3 cap at z = 0 (the reference: larger). Above: tilted about x, its centre at zc; its lowest rim
+    // point (a cap polygon vertex: the polygon has one at every quarter turn) sits at zc - hh cos t - r sin t.
+    auto lower = place(std::make_shared<Cylinder>(0.3, 0.4), Vec3(0, 0, -0.2), upright());
+    const Real zc = hh * std::cos(tilt) + r * std::sin(tilt) - 1e-3;
+    auto upper = place(std::make_shared<Cylinder>(r, 2 * hh), Vec3(0.01, 0.02, zc),
+                       Quat(Eigen::AngleAxis<Real>(tilt, Vec3::UnitX())) * upright());
+    std::vector<ContactPoint> c;
+    REQUIRE(collideGeometries(*upper, *lower, 0.005, c) == 4);
+    Real deepest = -1;
+    for (const auto& p : c) {
+      CHECK(p.normal.z() == doctest::Approx(1).epsilon(1e-12));  // snapped to the cap's exact normal
+      deepest = std::max(deepest, p.depth);
+      // Points lie on the upper cap's rim or inside it, and within the lower disc.
+      CHECK(std::hypot(p.point.x(), p.point.y()) <= 0.3 + 1e-9);
+    }
+    CHECK(deepest == doctest::Approx(1e-3).epsilon(1e-9));
+    // Moved by 1 um: the same features touch, the same ids come back (warm starting keys on them).
+    upper->setPosition(upper->getPosition() + Vec3(1e-6, -1e-6, 0));
+    std::vector<ContactPoint> c2;
+    collideGeometries(*upper, *lower, 0.005, c2);
+    CHECK(ids(c2) == ids(c));
+  }
+  SUBCASE("a cylinder lying on a box face: its side line clipped to the face, two points at the exact depth") {
+    auto box = place(std::make_shared<Box>(Vec3(0.5, 0.5, 0.5)), Vec3(0, 0, -0.5), Quat::Identity());
+    // Axis along x, 1 mm into the face, one end hanging 0.1 m over the edge at x = 0.5.
+    auto cyl = place(std::make_shared<Cylinder>(0.1, 0.4), Vec3(0.4, 0.1, 0.1 - 1e-3),
+                     Quat(Eigen::AngleAxis<Real>(kPi / 2, Vec3::UnitZ())));
+    std::vector<ContactPoint> c;
+    REQUIRE(collideGeometries(*cyl, *box, 0.005, c) == 2);
+    Real xmin = 1, xmax = -1;
+    for (const auto& p : c) {
+      CHECK(p.depth == doctest::Approx(1e-3).epsilon(1e-9));
+      CHECK(p.normal.z() == doctest::Approx(1).epsilon(1e-12));
+      xmin = std::min(xmin, p.point.x());
+      xmax = std::max(xmax, p.point.x());
+    }
+    CHECK(xmin == doctest::Approx(0.2).epsilon(1e-9));  // the cylinder's end
+    CHECK(xmax == doctest::Approx(0.5).epsilon(1e-9));  // the face's edge
+    cyl->setPosition(cyl->getPosition() + Vec3(1e-6, 0, 0));
+    std::vector<ContactPoint> c2;
+    collideGeometries(*cyl, *box, 0.005, c2);
+    CHECK(ids(c2) == ids(c));
+  }
+  SUBCASE("a capsule lying on a Convex face and a Convex cube on a cylinder's cap") {
+    auto hull = place(convexCube(0.5), Vec3(0, 0, -0.5), Quat::Identity());
+    auto cap = place(std::make_shared<Capsule>(0.1, 0.6), Vec3(0, 0, 0.1 - 2e-3), Quat::Identity());  // axis y
+    std::vector<ContactPoint> c;
+    REQUIRE(collideGeometries(*cap, *hull, 0.005, c) == 2);
+    for (const auto& p : c) CHECK(p.depth == doctest::Approx(2e-3).epsilon(1e-9));
+    CHECK(std::abs(c[0].point.y() - c[1].point.y()) == doctest::Approx(0.6).epsilon(1e-9));
+    // A 0.3 m hull cube on an r 0.2 cap: the cap (larger) is the reference and clips by its true circle; the
+    // cube's face (0.15 half width, corners at 0.212 > 0.2 from the axis) is cut at the rim.
+    auto cyl = place(std::make_shared<Cylinder>(0.2, 0.4), Vec3(0, 0, -0.2), upright());
+    auto cube = place(convexCube(0.15), Vec3(0, 0, 0.15 - 1e-3), Quat::Identity());
+    c.clear();
+    REQUIRE(collideGeometries(*cube, *cyl, 0.005, c) == 4);
+    for (const auto& p : c) {
+      CHECK(p.depth == doctest::Approx(1e-3).epsilon(1e-9));
+      CHECK(std::hypot(p.point.x(), p.point.y()) <= 0.2 * (1 + 1e-12));
+      CHECK(std::max(std::abs(p.point.x()), std::abs(p.point.y())) <= 0.15 * (1 + 1e-12));
+    }
+  }
+}
 
 TEST_CASE("six cylinders (r 0.2, h 0.4) stand on end 10 s within 1 cm") {
   std::vector<StackPart> parts(6, cylinderPart());

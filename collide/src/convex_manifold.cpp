@@ -57,8 +57,13 @@ struct Feature {
   Vec3 normal = Vec3::Zero();
   uint32_t id = 0;
   Real area = 0;
+  bool disc = false;  ///< a cylinder cap: as reference it clips by its true circle (centre, radius)
+  Vec3 centre = Vec3::Zero();
+  Real radius = 0;
   std::array<Vec3, kMaxFeaturePoints> p;
 };
+
+inline uint32_t labelPair(uint32_t a, uint32_t b) { return a < b ? (a << 7) | b : (b << 7) | a; }
 
 uint32_t hashIds(uint32_t a, uint32_t b) {
   uint32_t h = a * 0x9E3779B1u ^ (b + 0x7F4A7C15u + (a << 6) + (a >> 2));
@@ -76,15 +81,27 @@ Real polygonArea(const Feature& f) {
   return Real(0.5) * std::abs(s.dot(f.normal));
 }
 
-/// Number of cap polygon points for the sagitta tolerance (multiple of 4 in [8, 32]).
-int capPoints() {
-  static const int n = [] {
+/// Cap polygon: the number of points for the sagitta tolerance (a multiple of 4 in [8, 32]) and the unit circle
+/// at those angles, computed once.
+struct CapCircle {
+  int n = 0;
+  std::array<Real, kMaxFeaturePoints> s{}, c{};
+  Real areaFactor = 0;  // polygon area / r^2
+  CapCircle() {
+    const Real pi = Real(3.14159265358979323846);
     const Real half = std::acos(1 - kCapSagitta);  // pi / N at the tolerance
-    int m = int(std::ceil(Real(3.14159265358979323846) / half));
-    m = (m + 3) / 4 * 4;
-    return std::clamp(m, 8, 32);
-  }();
-  return n;
+    n = int(std::ceil(pi / half));
+    n = std::clamp((n + 3) / 4 * 4, 8, 32);
+    for (int k = 0; k < n; ++k) {
+      s[size_t(k)] = std::sin(2 * pi * k / n);
+      c[size_t(k)] = std::cos(2 * pi * k / n);
+    }
+    areaFactor = Real(0.5) * n * std::sin(2 * pi / n);
+  }
+};
+const CapCircle& capCircle() {
+  static const CapCircle circle;
+  return circle;
 }
 
 /// Supporting feature of shape s (placed by t) along the unit world direction d (outward from s).
@@ -92,6 +109,7 @@ void supportFeature(const Shape& s, const Transform& t, const Vec3& d, Feature& 
   const Real sinTol = std::sin(kFeatureAngle), cosTol = std::cos(kFeatureAngle);
   f.count = 0;
   f.area = 0;
+  f.disc = false;
   f.normal = d;
   switch (s.getType()) {
     case Shape::BOX: {
@@ -149,16 +167,18 @@ void supportFeature(const Shape& s, const Transform& t, const Vec3& d, Feature& 
       const Vec3 dl = t.rotateInverse(d);
       if (std::abs(dl.y()) >= cosTol) {
         const Real sg = dl.y() > 0 ? 1 : -1;
-        const int n = capPoints();
-        for (int k = 0; k < n; ++k) {
-          // Counter-clockwise about +y runs from +z towards +x: angle a at (sin a, ., cos a); about -y reversed.
-          const Real a = Real(2 * 3.14159265358979323846) * Real(k) / Real(n);
-          f.p[size_t(k)] = t.apply(Vec3(sg * r * std::sin(a), sg * hh, r * std::cos(a)));
-        }
-        f.count = n;
-        f.normal = t.rotate(Vec3(0, sg, 0));
+        const CapCircle& cc = capCircle();
+        const Mat3 R = t.q.toRotationMatrix();
+        const Vec3 centre = t.p + R.col(1) * (sg * hh), ex = R.col(0) * (sg * r), ez = R.col(2) * r;
+        // Counter-clockwise about +y runs from +z towards +x: angle a at (sin a, ., cos a); about -y x flips.
+        for (int k = 0; k < cc.n; ++k) f.p[size_t(k)] = centre + ex * cc.s[size_t(k)] + ez * cc.c[size_t(k)];
+        f.count = cc.n;
+        f.normal = R.col(1) * sg;
         f.id = sg > 0 ? 1 : 0;
-        f.area = Real(0.5) * n * r * r * std::sin(Real(2 * 3.14159265358979323846) / n);
+        f.area = cc.areaFactor * r * r;
+        f.disc = true;
+        f.centre = centre;
+        f.radius = r;
         return;
       }
       const Vec3 radial(dl.x(), 0, dl.z());
@@ -311,21 +331,87 @@ int manifoldFromNormal(const Shape& s0, const Transform& t0, const Shape& s1, co
   const Feature& R = refIsB ? fb : fa;
   Feature& I = refIsB ? fa : fb;
   const Vec3 nRef = R.normal;  // outward from the reference shape towards the incident one
-  // Incident feature again along the exact face normal.
-  if (refIsB)
-    supportFeature(s0, t0, -nRef, I);
-  else
-    supportFeature(s1, t1, -nRef, I);
-  if (I.count < 2) return 0;
+  // A segment or point depends on the direction: take it again along the exact face normal. (A polygon does
+  // not; its choice only flips at the tolerance's edge.)
+  if (I.count < 3) {
+    if (refIsB)
+      supportFeature(s0, t0, -nRef, I);
+    else
+      supportFeature(s1, t1, -nRef, I);
+    if (I.count < 2) return 0;
+  }
   const Real refOffset = nRef.dot(R.p[0]);
   const Vec3 normal = refIsB ? nRef : Vec3(-nRef);
   const uint32_t base = hashIds(hashIds(uint32_t(refIsB), fa.id), fb.id) & 0x7FFFC000u;
+  // Clipping emits a point twice only where an incident vertex lies exactly on a side plane, and then the two
+  // copies are neighbours in the clipped polygon: comparing with the last point kept (and the first, for the
+  // wrap-around) removes them at O(1) per point.
+  auto same = [](const Vec3& a, const Vec3& b) {
+    return (a - b).cwiseAbs().maxCoeff() <= Real(1e-9) * (1 + a.cwiseAbs().maxCoeff());
+  };
   auto emit = [&](const Vec3& p, uint32_t label) {
     const Real sep = nRef.dot(p) - refOffset;
     const Vec3 x = p - nRef * (Real(0.5) * sep);
-    if (sep > margin || nearExisting(out, begin, x)) return;
+    if (sep > margin) return;
+    if (out.size() > begin && (same(out.back().point, x) || same(out[begin].point, x))) return;
     out.push_back(makeContact(x, normal, -sep, base | label));
   };
+  if (R.disc) {
+    // Reference cap: clip by its true circle in the plane across nRef. The intersection of the disc and the
+    // incident polygon is bounded by incident vertices inside the circle, crossings of incident edges with it,
+    // and arcs, which the cap polygon's rim points (on the circle) inside the incident polygon stand for.
+    const Vec3 c = R.centre;
+    const Real r2 = R.radius * R.radius;
+    auto across = [&](const Vec3& v) { return Vec3(v - nRef * nRef.dot(v)); };
+    // Parameters where segment a-b (projected) enters and leaves the circle; false when it misses.
+    auto crossings = [&](const Vec3& a, const Vec3& b, Real& tIn, Real& tOut) {
+      const Vec3 m = across(a - c), d = across(b - a);
+      const Real dd = d.squaredNorm();
+      if (dd <= Real(1e-24)) return false;
+      const Real bq = m.dot(d), disc = bq * bq - dd * (m.squaredNorm() - r2);
+      if (disc <= 0) return false;
+      const Real sq = std::sqrt(disc);
+      tIn = (-bq - sq) / dd;
+      tOut = (-bq + sq) / dd;
+      return true;
+    };
+    if (I.count == 2) {
+      Real tIn, tOut;
+      if (!crossings(I.p[0], I.p[1], tIn, tOut) || tIn >= 1 || tOut <= 0) return 0;
+      const Real lo = std::max<Real>(0, tIn), hi = std::min<Real>(1, tOut);
+      const Vec3 d = I.p[1] - I.p[0];
+      emit(I.p[0] + lo * d, lo > 0 ? 64 : 0);
+      emit(I.p[0] + hi * d, (1u << 7) | (hi < 1 ? 65 : 1));
+      return int(out.size() - begin);
+    }
+    const int n = I.count;
+    for (int k = 0; k < n; ++k) {
+      const Vec3& a = I.p[size_t(k)];
+      const Vec3& b = I.p[size_t((k + 1) % n)];
+      if (across(a - c).squaredNorm() <= r2) emit(a, labelPair(uint32_t((k + n - 1) % n & 63), uint32_t(k & 63)));
+      Real tIn, tOut;
+      if (crossings(a, b, tIn, tOut)) {
+        if (tIn > 0 && tIn < 1) emit(a + tIn * (b - a), labelPair(uint32_t(k & 63), 64));
+        if (tOut > 0 && tOut < 1) emit(a + tOut * (b - a), labelPair(uint32_t(k & 63), 65));
+      }
+    }
+    // Rim points inside the incident polygon, carried along nRef onto its plane.
+    const Vec3 nI = I.normal;
+    const Real den = nI.dot(nRef);
+    if (std::abs(den) > Real(0.5)) {
+      for (int j = 0; j < R.count; ++j) {
+        const Vec3& x = R.p[size_t(j)];
+        const Vec3 y = x + nRef * (nI.dot(I.p[0] - x) / den);
+        bool inside = true;
+        for (int k = 0; k < n && inside; ++k) {
+          const Vec3& a = I.p[size_t(k)];
+          inside = (I.p[size_t((k + 1) % n)] - a).cross(nI).dot(y - a) <= 0;
+        }
+        if (inside) emit(y, labelPair(uint32_t(64 + (j & 63)), 127));
+      }
+    }
+    return reduceManifold(out, begin, 4);
+  }
   if (I.count == 2) {
     Vec3 a = I.p[0], b = I.p[1];
     uint8_t la = 0, lb = 1;
