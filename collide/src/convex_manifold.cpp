@@ -356,16 +356,29 @@ int manifoldFromNormal(const Shape& s0, const Transform& t0, const Shape& s1, co
     if (out.size() > begin && (same(out.back().point, x) || same(out[begin].point, x))) return;
     out.push_back(makeContact(x, normal, -sep, base | label));
   };
-  if (R.disc) {
-    // Reference cap: clip by its true circle in the plane across nRef. The intersection of the disc and the
-    // incident polygon is bounded by incident vertices inside the circle, crossings of incident edges with it,
-    // and arcs, which the cap polygon's rim points (on the circle) inside the incident polygon stand for.
-    const Vec3 c = R.centre;
-    const Real r2 = R.radius * R.radius;
-    auto across = [&](const Vec3& v) { return Vec3(v - nRef * nRef.dot(v)); };
-    // Parameters where segment a-b (projected) enters and leaves the circle; false when it misses.
+  if (R.disc || (I.disc && I.count >= 3)) {
+    // A cylinder cap on either side: intersect the other feature with its true circle, working in the cap's
+    // plane (points of the other feature are carried there along nRef, which keeps lines straight and the
+    // circle exact). The region is bounded by the other feature's vertices inside the circle, the crossings of
+    // its edges with the circle, and arcs, for which the cap's rim points (on the circle) inside the other
+    // feature stand. Each point is then reported on the incident surface.
+    const Feature& D = R.disc ? R : I;
+    const Feature& P = R.disc ? I : R;
+    const bool discIsRef = R.disc;
+    const Vec3 nD = D.normal, c = D.centre;
+    const Real r2 = D.radius * D.radius;
+    const Real denD = nD.dot(nRef);
+    const Vec3 pBase = P.disc ? P.centre : P.p[0];
+    const Real denP = P.normal.dot(nRef);
+    if (std::abs(denD) < Real(0.5) || std::abs(denP) < Real(0.5)) return 0;
+    auto toD = [&](const Vec3& x) { return Vec3(x + nRef * (nD.dot(c - x) / denD)); };
+    auto toP = [&](const Vec3& x) { return Vec3(x + nRef * (P.normal.dot(pBase - x) / denP)); };
+    // A point of P (given on P) and of D (given on D), reported on the incident one.
+    auto emitFromP = [&](const Vec3& x, uint32_t label) { emit(discIsRef ? x : toD(x), label); };
+    auto emitFromD = [&](const Vec3& y, uint32_t label) { emit(discIsRef ? toP(y) : y, label); };
+    // Parameters where segment a-b (in D's plane) enters and leaves the circle; false when it misses.
     auto crossings = [&](const Vec3& a, const Vec3& b, Real& tIn, Real& tOut) {
-      const Vec3 m = across(a - c), d = across(b - a);
+      const Vec3 m = a - c, d = b - a;
       const Real dd = d.squaredNorm();
       if (dd <= Real(1e-24)) return false;
       const Real bq = m.dot(d), disc = bq * bq - dd * (m.squaredNorm() - r2);
@@ -375,40 +388,47 @@ int manifoldFromNormal(const Shape& s0, const Transform& t0, const Shape& s1, co
       tOut = (-bq + sq) / dd;
       return true;
     };
-    if (I.count == 2) {
+    if (P.count == 2) {
       Real tIn, tOut;
-      if (!crossings(I.p[0], I.p[1], tIn, tOut) || tIn >= 1 || tOut <= 0) return 0;
+      const Vec3 a = toD(P.p[0]), b = toD(P.p[1]);
+      if (!crossings(a, b, tIn, tOut) || tIn >= 1 || tOut <= 0) return 0;
       const Real lo = std::max<Real>(0, tIn), hi = std::min<Real>(1, tOut);
-      const Vec3 d = I.p[1] - I.p[0];
-      emit(I.p[0] + lo * d, lo > 0 ? 64 : 0);
-      emit(I.p[0] + hi * d, (1u << 7) | (hi < 1 ? 65 : 1));
+      const Vec3 d = P.p[1] - P.p[0];
+      emitFromP(P.p[0] + lo * d, lo > 0 ? 64 : 0);
+      emitFromP(P.p[0] + hi * d, (1u << 7) | (hi < 1 ? 65 : 1));
       return int(out.size() - begin);
     }
-    const int n = I.count;
+    const int n = P.count;
     for (int k = 0; k < n; ++k) {
-      const Vec3& a = I.p[size_t(k)];
-      const Vec3& b = I.p[size_t((k + 1) % n)];
-      if (across(a - c).squaredNorm() <= r2) emit(a, labelPair(uint32_t((k + n - 1) % n & 63), uint32_t(k & 63)));
+      const Vec3& a = P.p[size_t(k)];
+      const Vec3& b = P.p[size_t((k + 1) % n)];
+      const Vec3 aD = toD(a), bD = toD(b);
+      if ((aD - c).squaredNorm() <= r2) emitFromP(a, labelPair(uint32_t((k + n - 1) % n & 63), uint32_t(k & 63)));
       Real tIn, tOut;
-      if (crossings(a, b, tIn, tOut)) {
-        if (tIn > 0 && tIn < 1) emit(a + tIn * (b - a), labelPair(uint32_t(k & 63), 64));
-        if (tOut > 0 && tOut < 1) emit(a + tOut * (b - a), labelPair(uint32_t(k & 63), 65));
+      if (crossings(aD, bD, tIn, tOut)) {
+        if (tIn > 0 && tIn < 1) emitFromP(a + tIn * (b - a), labelPair(uint32_t(k & 63), 64));
+        if (tOut > 0 && tOut < 1) emitFromP(a + tOut * (b - a), labelPair(uint32_t(k & 63), 65));
       }
     }
-    // Rim points inside the incident polygon, carried along nRef onto its plane.
-    const Vec3 nI = I.normal;
-    const Real den = nI.dot(nRef);
-    if (std::abs(den) > Real(0.5)) {
-      for (int j = 0; j < R.count; ++j) {
-        const Vec3& x = R.p[size_t(j)];
-        const Vec3 y = x + nRef * (nI.dot(I.p[0] - x) / den);
-        bool inside = true;
-        for (int k = 0; k < n && inside; ++k) {
-          const Vec3& a = I.p[size_t(k)];
-          inside = (I.p[size_t((k + 1) % n)] - a).cross(nI).dot(y - a) <= 0;
-        }
-        if (inside) emit(y, labelPair(uint32_t(64 + (j & 63)), 127));
+    // D's rim points inside P (P's true circle when P is a cap too).
+    const Real rP2 = P.radius * P.radius * (1 + Real(1e-12));
+    thread_local std::array<Vec3, kMaxFeaturePoints> side;
+    thread_local std::array<Real, kMaxFeaturePoints> sideOffset;
+    if (!P.disc)
+      for (int k = 0; k < n; ++k) {
+        side[size_t(k)] = (P.p[size_t((k + 1) % n)] - P.p[size_t(k)]).cross(P.normal);
+        sideOffset[size_t(k)] = side[size_t(k)].dot(P.p[size_t(k)]);
       }
+    for (int j = 0; j < D.count; ++j) {
+      const Vec3& y = D.p[size_t(j)];
+      const Vec3 x = toP(y);
+      bool inside = true;
+      if (P.disc) {
+        inside = (x - P.centre).squaredNorm() <= rP2;
+      } else {
+        for (int k = 0; k < n && inside; ++k) inside = side[size_t(k)].dot(x) <= sideOffset[size_t(k)];
+      }
+      if (inside) emitFromD(y, labelPair(uint32_t(64 + (j & 63)), 127));
     }
     return reduceManifold(out, begin, 4);
   }
