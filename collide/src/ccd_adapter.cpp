@@ -1,8 +1,9 @@
 // libccd adapter: the only file that includes libccd (docs/design.md §1).
 //
 // Used for the convex pairs without an analytic routine (cylinder-cylinder, cylinder-box, cylinder-capsule,
-// cylinder-convex, sphere-convex, capsule-convex). One point per call: a curved pair gets a new point every step
-// as it rolls, which is acceptable for these pairs (cylinder-box adds a full manifold for a cap lying on a face,
+// cylinder-convex, sphere-convex, capsule-convex). One point per call; every pair but sphere-convex then takes
+// its normal to convex_manifold.cpp, which builds the manifold from the two supporting features (a cap, side line
+// or face resting on another gets up to 4 points; cylinder-box keeps its analytic cap-on-face path,
 // cylinder_box.cpp).
 //
 // Debian's libccd is built with CCD_DOUBLE (ccd/config.h), so ccd_real_t is double like scree::Real; the

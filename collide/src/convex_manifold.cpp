@@ -26,15 +26,26 @@
 //     distance below the reference plane; points more than `margin` above it are dropped. Two segments (parallel
 //     capsules or cylinders lying side by side) clip shape 0's segment by the end planes of shape 1's; crossed
 //     segments keep the single point.
+//     A cylinder cap on either side is clipped as its true circle, not the polygon: in the cap's plane (the other
+//     feature carried there along the reference normal) the region is bounded by the other feature's vertices
+//     inside the circle, its edges' crossings with the circle, and the cap's rim points inside the other
+//     feature (they stand for the arcs). That is exact at the rim and costs O(n) instead of O(n^2) clip tests for
+//     a cap on a cap.
 //  3. Reduction: at most 4 points, the deepest, then the farthest from it, then the two spanning the largest
 //     signed area on either side of that segment (reduceManifold), so the kept quadrilateral spans the contact
 //     area and the centre of pressure can sit anywhere in it.
 //
 // Feature ids: (hash of reference side, feature id of shape 0, feature id of shape 1) in bits 14..30, the clip
 // label of the point in bits 0..13 (ClipVertex labels: incident edge k = k, reference side plane k = 64 + k; for a
-// segment, its end e = e). Shape feature ids: box face f = f, edge 8 + 4 axis + sign bits; cylinder cap 0/1, side
-// 2; capsule segment 1; hull face index. All are fixed in the shape's frame, so the same touching features give
-// the same ids step after step (warm starting, contact_rows.h; its position fallback covers roundoff).
+// segment, its end e = e; against a circle, a polygon vertex is the pair of its edges, an edge crossing the pair
+// (edge, 64 entering / 65 leaving), a rim point j the pair (64 + j, 127)). Shape feature ids: box face f = f
+// (makeBoxPolytope's order), edge 8 + 8 axis + the sign bits of the other two axes; cylinder cap 0 (-y) / 1 (+y),
+// side 2; capsule segment 1; hull face index. All are fixed in the shape's frame, so the same touching features
+// give the same ids step after step (warm starting, contact_rows.h; its position fallback covers roundoff).
+//
+// The analytic paths stay where they are exact and faster: box-box, box-plane, capsule-capsule, capsule-box,
+// cylinder-plane, convex-convex/-box (SAT), and the cylinder cap lying on a box face (cylinder_box.cpp). Cost per
+// pair type: bench/bench_narrowphase.cpp, table in docs/design.md.
 #include <algorithm>
 #include <array>
 #include <cmath>

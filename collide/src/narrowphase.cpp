@@ -5,8 +5,9 @@
 // convention right once (normal from its second shape towards its first).
 //
 // Feature ids: sphere pairs 0; capsule ends 1 and 2 (0 for a single closest point); box-plane and convex-plane
-// the vertex index; cylinder-plane cap * 8 + rim point; cylinder-box see cylinder_box.cpp. Lines report only
-// the entry point (id 0).
+// the vertex index; cylinder-plane cap * 8 + rim point; cylinder-box see cylinder_box.cpp; the libccd pairs
+// with a manifold (capsule-cylinder, capsule-convex, cylinder-cylinder, cylinder-convex) see convex_manifold.cpp.
+// Lines report only the entry point (id 0).
 //
 // Lines are sensors: a line contact is the point where the segment, walked from its first point to its second,
 // enters the shape; the normal is the shape's outward surface normal there and the depth is the length of the

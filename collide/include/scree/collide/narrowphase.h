@@ -6,9 +6,12 @@
 //
 // Conventions: normal points from geometry 1 towards geometry 0 (geometry 0 is pushed along +normal),
 // depth > 0 is overlap, depth < 0 a gap. Points with depth >= -margin are returned (speculative contacts,
-// so fast bodies do not tunnel). At most 4 points per pair; box-box, box-plane, box-height-field and
-// convex-face pairs produce full manifolds. Each point carries a featureId that stays the same while the
-// same features touch (warm starting keys on it).
+// so fast bodies do not tunnel). At most 4 points per pair. Every convex pair gets a full manifold where its
+// shapes touch along a face, cap or line: box-box, box-plane, box-height-field and convex-convex by SAT and
+// clipping; the pairs without an analytic routine (cylinder, capsule and hull pairs) by clipping the two
+// shapes' supporting features along the penetration normal (collide/src/convex_manifold.cpp,
+// docs/design.md "Contact manifolds for every convex pair"). Each point carries a featureId that stays the
+// same while the same features touch (warm starting keys on it).
 #pragma once
 
 #include <vector>
