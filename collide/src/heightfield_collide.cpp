@@ -881,6 +881,21 @@ int collideCylinderHeightField(const Shape& s0, const Transform& t0, const Shape
         Real zhi = -std::numeric_limits<Real>::max();
         for (const auto& p : vv) zhi = std::max(zhi, g.hf.getHeight(size_t(p[0]), size_t(p[1])));
         if (zhi < zlo - margin) continue;
+        // Cheap cull: the cylinder's own bounding box (|x|, |z| <= r, |y| <= hh in its frame) against the
+        // triangle's vertices, one axis at a time.
+        bool apart = false;
+        for (int ax = 0; ax < 3 && !apart; ++ax) {
+          const Vec3& d = ax == 0 ? C.ex : (ax == 1 ? C.w : C.ez);
+          const Real ext = (ax == 1 ? C.hh : C.r) + margin + Real(1e-9) * (C.r + C.hh), dc = d.dot(C.c);
+          Real lo = std::numeric_limits<Real>::max(), hi = -lo;
+          for (const auto& p : vv) {
+            const Real x = d.dot(g.vert(p[0], p[1])) - dc;
+            lo = std::min(lo, x);
+            hi = std::max(hi, x);
+          }
+          apart = lo > ext || hi < -ext;
+        }
+        if (apart) continue;
         cylinderTriangle(g, i, j, t, C, margin, begin, out);
       }
     }
