@@ -13,7 +13,7 @@
 // owns a shared edge or vertex so it is reported once. Feature id = triangle * 8 + region (0 face, 1..3 edges,
 // 4..6 vertices); the capsule uses triangle * 8 + site (0, 1 end spheres, 2 the segment's closest point).
 //
-// Box, convex and cylinder: exact SAT per triangle under the shape's footprint (height-field frame): the triangle
+// Box and convex: exact SAT per triangle under the shape's footprint (height-field frame): the triangle
 // normal (+n only: solid below), the shape's face normals, and triangle edge x shape edge directions. Internal
 // edges: an axis other than the triangle normal is only accepted as the contact normal when it lies in the normal
 // cone of the triangle feature supporting it (validNormal: every neighbouring grid vertex on or below the plane
@@ -24,9 +24,18 @@
 // neighbour continues the region); shape face -> the triangle clipped by that face; edge axis -> midpoint of the
 // closest points of the two edges. Points of all triangles are merged (first, i.e. lowest triangle, wins a
 // duplicate position) and reduced; id = triangle * 8 + local (a 3-bit hash of face and clip label, 7 for edges).
-// The cylinder is a 16-gon prism rebuilt per triangle with a rim vertex at its deepest point along -n, so face
-// contacts (lowest generator, cap rim) are exact; only rim vertices of a cap become points (no clip crossings).
-// Edge/vertex contacts with the curved side are approximate (inside by at most r (1 - cos(pi / 16))).
+// Cylinder: its true circle, no polygonal stand-in (see "cylinder against the triangles" below for the axes and
+// points). Per triangle an SAT over the face normal, the cap normal and, for each triangle edge that is not a flat
+// internal join, the normal at the edge point of least signed distance to the cylinder (a convex 1D minimum, in
+// closed form unless the point is near a rim). The cylinder's support along any axis is exact, so depths are exact
+// on faces, edges and vertices (edge against the curved side, a vertex anywhere, an edge against a rim when apart);
+// only an edge pressed into a rim is measured along the side or cap normal there, not along the true common
+// normal of edge and circle (the overlap along a nearby axis: an over-estimate while it lasts, exact again once the
+// speculative contact parts them or they touch). Manifold: a lying cylinder gives the two
+// ends of its line of contact, an upright one 4 rim points fixed in its frame; both get ids from the cylinder's
+// own features, and each such point is reported by the one triangle whose footprint holds it, so ids survive
+// the cylinder's moving from cell to cell (warm starting). The capsule needs nothing of the sort: its sphere
+// sites are exact.
 // All pairs reduce to at most 4 points, deepest first.
 #include <algorithm>
 #include <cmath>
