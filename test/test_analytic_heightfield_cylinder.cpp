@@ -125,6 +125,19 @@ TEST_SUITE("collide.heightfield.cylinder") {
         CHECK(std::abs(c[0].depth + 0.005) <= 1e-9 * r);
       }
     }
+    // Lying along the ridge (edges parallel to the axis), y in [-0.1, 0.7] across the ridge vertex at y = 0: the
+    // ends of each ridge edge's part under the cylinder, depth exact, one point per position.
+    {
+      auto along = place(std::make_shared<Cylinder>(r, 0.8), Vec3(0, 0.3, 1 + r - depth), axisTo(Vec3::UnitY(), 0.05));
+      auto c = collide(*along, *roof);
+      REQUIRE(c.size() == 3);
+      for (const auto& p : c) {
+        CHECK(std::abs(p.depth - depth) <= 1e-9 * r);
+        CHECK((p.normal - Vec3::UnitZ()).norm() <= 1e-9);
+        const Real y = p.point.y();
+        CHECK((std::abs(y + 0.1) < 1e-9 || std::abs(y) < 1e-9 || std::abs(y - 0.7) < 1e-9));
+      }
+    }
     // Peak: one vertex (0, 0) raised to 1 on a 9 x 9 flat field of 0.5 m cells. Cylinder lying along y with its
     // axis 0.1 m to the side of the peak: depth r - |(0.1, 0, zc - 1)|, normal along that radial line.
     auto peak = place(field(9, 4, [](Real x, Real y) { return std::hypot(x, y) < 1e-12 ? Real(1) : Real(0); }),
