@@ -13,7 +13,7 @@
 // owns a shared edge or vertex so it is reported once. Feature id = triangle * 8 + region (0 face, 1..3 edges,
 // 4..6 vertices); the capsule uses triangle * 8 + site (0, 1 end spheres, 2 the segment's closest point).
 //
-// Box, convex and cylinder: exact SAT per triangle under the shape's footprint (height-field frame): the triangle
+// Box and convex: exact SAT per triangle under the shape's footprint (height-field frame): the triangle
 // normal (+n only: solid below), the shape's face normals, and triangle edge x shape edge directions. Internal
 // edges: an axis other than the triangle normal is only accepted as the contact normal when it lies in the normal
 // cone of the triangle feature supporting it (validNormal: every neighbouring grid vertex on or below the plane
@@ -24,9 +24,18 @@
 // neighbour continues the region); shape face -> the triangle clipped by that face; edge axis -> midpoint of the
 // closest points of the two edges. Points of all triangles are merged (first, i.e. lowest triangle, wins a
 // duplicate position) and reduced; id = triangle * 8 + local (a 3-bit hash of face and clip label, 7 for edges).
-// The cylinder is a 16-gon prism rebuilt per triangle with a rim vertex at its deepest point along -n, so face
-// contacts (lowest generator, cap rim) are exact; only rim vertices of a cap become points (no clip crossings).
-// Edge/vertex contacts with the curved side are approximate (inside by at most r (1 - cos(pi / 16))).
+// Cylinder: its true circle, no polygonal stand-in (see "cylinder against the triangles" below for the axes and
+// points). Per triangle an SAT over the face normal, the cap normal and, for each triangle edge that is not a flat
+// internal join, the normal at the edge point of least signed distance to the cylinder (a convex 1D minimum, in
+// closed form unless the point is near a rim). The cylinder's support along any axis is exact, so depths are exact
+// on faces, edges and vertices (edge against the curved side, a vertex anywhere, an edge against a rim when apart);
+// only an edge pressed into a rim is measured along the side or cap normal there, not along the true common
+// normal of edge and circle (the overlap along a nearby axis: an over-estimate while it lasts, exact again once the
+// speculative contact parts them or they touch). Manifold: a lying cylinder gives the two
+// ends of its line of contact, an upright one 4 rim points fixed in its frame; both get ids from the cylinder's
+// own features, and each such point is reported by the one triangle whose footprint holds it, so ids survive
+// the cylinder's moving from cell to cell (warm starting). The capsule needs nothing of the sort: its sphere
+// sites are exact.
 // All pairs reduce to at most 4 points, deepest first.
 #include <algorithm>
 #include <cmath>
@@ -272,10 +281,9 @@ uint32_t localId(uint32_t a, uint32_t b) {
 }
 
 /// Triangle (i, j, t) against polytope P (height-field frame). Appends points (deduplicated against
-/// out[begin..)). `capFaces`: faces with more than 4 vertices approximate round caps, so only their own
-/// vertices (on the true rim) become points, not clip crossings.
+/// out[begin..)).
 void polytopeTriangle(const Grid& g, long i, long j, int t, const Polytope& P, const std::vector<Vec3>& dirs,
-                      Real margin, bool capFaces, size_t begin, std::vector<ContactPoint>& out) {
+                      Real margin, size_t begin, std::vector<ContactPoint>& out) {
   const Tri T = makeTri(g, i, j, t);
   const Vec3 tv[3] = {T.a, T.b, T.c};
   const Real scale = g.dx + g.dy + std::abs(T.a.z());
@@ -385,13 +393,11 @@ void polytopeTriangle(const Grid& g, long i, long j, int t, const Polytope& P, c
     for (uint32_t k = 0; k < IF.count; ++k) inc.push_back(P.verts[P.indices[IF.first + k]]);
     initIncident(inc.data(), int(inc.size()), poly);
     clipToReference(poly, tv, 3, T.n, scratch);
-    const bool cap = capFaces && IF.count > 4;
     bool flat[3];
     for (int k = 0; k < 3; ++k) flat[k] = flatJoin(g, i, j, t, T, k, tol);
     for (const ClipVertex& v : poly) {
       // Crossings of a flat internal join lie inside the merged contact region (the neighbour continues it).
       const bool onA = v.la >= 64, onB = v.lb >= 64;
-      if (cap && (onA || onB)) continue;
       if ((onA || onB) && (!onA || flat[v.la - 64]) && (!onB || flat[v.lb - 64])) continue;
       const Real sep = T.n.dot(v.p - T.a);
       if (sep > margin) continue;
@@ -415,72 +421,10 @@ void polytopeTriangle(const Grid& g, long i, long j, int t, const Polytope& P, c
   }
 }
 
-/// Cylinder as an n-gon prism (height-field frame). Vertex 0 of each cap sits at the rim point deepest along -up
-/// (fixed at local +x when the cylinder is nearly parallel to up). Built per triangle with up = the triangle
-/// normal, so face contacts of a lying cylinder (its lowest generator) and of an upright one (its rim) are exact;
-/// elsewhere the prism is inside the cylinder by at most r (1 - cos(pi / n)).
-void makeCylinderPrism(Real r, Real hh, const Transform& rel, const Vec3& up, int n, Polytope& P) {
-  P.clear();
-  const Vec3 upL = rel.rotateInverse(up);
-  const Real rl = std::hypot(upL.x(), upL.z());
-  const Real phi0 = rl < Real(0.045) ? Real(0) : std::atan2(-upL.z(), -upL.x());
-  for (int s = 0; s < 2; ++s) {
-    const Real y = s ? hh : -hh;
-    for (int k = 0; k < n; ++k) {
-      const Real a = phi0 + Real(6.283185307179586) * Real(k) / Real(n);
-      P.verts.push_back(rel.apply(Vec3(r * std::cos(a), y, r * std::sin(a))));
-    }
-  }
-  const Vec3 c = rel.p;
-  auto addFace = [&](std::vector<uint32_t> idx, const Vec3& outward) {
-    Vec3 nrm = Vec3::Zero();
-    for (size_t k = 0; k < idx.size(); ++k) {
-      const Vec3& p = P.verts[idx[k]];
-      const Vec3& q = P.verts[idx[(k + 1) % idx.size()]];
-      nrm += p.cross(q);
-    }
-    if (nrm.dot(outward) < 0) {
-      std::reverse(idx.begin(), idx.end());
-      nrm = -nrm;
-    }
-    Polytope::Face F;
-    F.first = uint32_t(P.indices.size());
-    F.count = uint32_t(idx.size());
-    F.normal = nrm.normalized();
-    F.offset = F.normal.dot(P.verts[idx[0]]);
-    for (uint32_t x : idx) P.indices.push_back(x);
-    P.faces.push_back(F);
-  };
-  const Vec3 w = rel.rotate(Vec3::UnitY());
-  std::vector<uint32_t> bottom, top;
-  for (int k = 0; k < n; ++k) {
-    bottom.push_back(uint32_t(k));
-    top.push_back(uint32_t(n + k));
-  }
-  addFace(bottom, -w);
-  addFace(top, w);
-  for (int k = 0; k < n; ++k) {
-    const uint32_t a = uint32_t(k), b = uint32_t((k + 1) % n);
-    const Vec3 mid = Real(0.5) * (P.verts[a] + P.verts[b]) - c;
-    addFace({a, b, b + uint32_t(n), a + uint32_t(n)}, mid - w * w.dot(mid));
-    P.edges.emplace_back(a, b);
-    P.edges.emplace_back(a + uint32_t(n), b + uint32_t(n));
-    P.edges.emplace_back(a, a + uint32_t(n));
-  }
-}
-
-struct CylinderPrism {
-  Real r, hh;
-  const Transform* rel;
-};
-constexpr int kCylinderSides = 16;
-
-/// `cyl` set: P is rebuilt per triangle as a prism aligned with the triangle normal.
 int polytopeHeightField(Polytope& P, const Grid& g, long i0, long i1, long j0, long j1, Real margin,
-                        const CylinderPrism* cyl, std::vector<ContactPoint>& out) {
+                        std::vector<ContactPoint>& out) {
   const size_t begin = out.size();
   thread_local std::vector<Vec3> dirs;
-  if (cyl) makeCylinderPrism(cyl->r, cyl->hh, *cyl->rel, Vec3::UnitZ(), kCylinderSides, P);
   uniqueEdgeDirs(P, dirs);
   Real zlo = std::numeric_limits<Real>::max();
   for (const Vec3& v : P.verts) zlo = std::min(zlo, v.z());
@@ -492,15 +436,340 @@ int polytopeHeightField(Polytope& P, const Grid& g, long i0, long i1, long j0, l
         Real zhi = -std::numeric_limits<Real>::max();
         for (const auto& p : vv) zhi = std::max(zhi, g.hf.getHeight(size_t(p[0]), size_t(p[1])));
         if (zhi < zlo - margin) continue;  // the whole triangle lies below the shape by more than the margin
-        if (cyl) {
-          makeCylinderPrism(cyl->r, cyl->hh, *cyl->rel, makeTri(g, i, j, t).n, kCylinderSides, P);
-          uniqueEdgeDirs(P, dirs);
-        }
-        polytopeTriangle(g, i, j, t, P, dirs, margin, cyl != nullptr, begin, out);
+        polytopeTriangle(g, i, j, t, P, dirs, margin, begin, out);
       }
     }
   }
   return int(out.size() - begin);
+}
+
+// --- cylinder against the triangles with its true circle ----------------------------------------------------
+//
+// Per triangle a SAT over the axes that can be the contact normal of a triangle and a round cylinder, each with
+// the cylinder's exact support min_x L.x = L.c - hh |L.w| - r |L - (L.w) w| (no polygonal stand-in):
+//   face  L = n: depth n.a - min_cyl(n);
+//   cap   L = w (or -w, whichever points out of the field): a triangle feature pressing into a cap;
+//   edge  for each triangle edge that is not a flat internal join: the edge point x* of least signed distance to
+//         the cylinder, f(s) = sd(a + s (b - a)), and L = the cylinder's normal there (x* to its closest cylinder
+//         point when apart, the nearest side or cap normal when inside). This is the exact edge/vertex-side and,
+//         when apart, edge/vertex-rim common normal; its overlap along L is the SAT value.
+// f is convex (the signed distance of a convex set). With g1 = rho - r (radial) and g2 = |y| - hh (axial) along the
+// edge, f = hypot(g1, g2) when both are positive and max(g1, g2) otherwise, so f >= max(g1, g2) and f rises with
+// each: the minimiser lies between s1 = argmin g1 (closed form, the distance of two lines) and s2 = argmin g2
+// (y = 0). If f equals g1 at s1 (or g2 at s2) that point is the minimum; otherwise (an edge near the rim) golden
+// section on [s1, s2] to 1e-13 of the edge.
+// Choice: least overlap, the face normal preferred, then the cap, then edges (5 % + 1e-7 hysteresis); a cap or
+// edge normal must lie in the normal cone of the triangle feature supporting it (validNormal) so flat and concave
+// joins never give one. Any axis separating by more than the margin drops the triangle.
+// Points (all positions in xy are owned by exactly one triangle, so per-cylinder features get ids that survive
+// crossing from cell to cell: kCylFeature | feature):
+//   face, cap upright (axis within 2.6 deg of n, as cylinderPlane in narrowphase.cpp): 4 rim points at fixed
+//     angles of the cylinder frame, each from the triangle whose footprint holds it;
+//   face, otherwise: the lowest generator c - r u +- hh w (u = n without its w part, normalised) clipped to the
+//     triangle's footprint: its ends (the two rim points ending the line of contact of a lying cylinder, or the
+//     lowest rim point of a tilted one) where the triangle owns them, and its crossings of non-flat edges;
+//   cap: triangle vertices within the disc, crossings of the edges with the rim, and the 8 fixed rim points
+//     whose projection along the axis falls on the triangle;
+//   edge: x* (two points, the ends of the overlap, when the edge runs along the axis within 0.06 deg).
+constexpr uint32_t kCylFeature = 0x80000000u;
+constexpr int kRimPoints = 4;
+constexpr Real kUprightSin = 0.045;  // |n x w| below this: the cap lies on the face (cylinderPlane's threshold)
+
+struct CylinderHF {
+  Vec3 c, w, ex, ez;  ///< centre, axis (local y), local x and z, height-field frame
+  Real r, hh;
+};
+
+/// min over the cylinder of L.x (exact support).
+Real cylMin(const CylinderHF& C, const Vec3& L) {
+  const Real lw = L.dot(C.w);
+  return L.dot(C.c) - C.hh * std::abs(lw) - C.r * (L - lw * C.w).norm();
+}
+
+struct SdPoint {
+  Real f, g1, g2, y, rho;
+  Vec3 q;  ///< radial part of x - c
+};
+
+SdPoint signedDistance(const CylinderHF& C, const Vec3& x) {
+  SdPoint e;
+  const Vec3 d = x - C.c;
+  e.y = d.dot(C.w);
+  e.q = d - e.y * C.w;
+  e.rho = e.q.norm();
+  e.g1 = e.rho - C.r;
+  e.g2 = std::abs(e.y) - C.hh;
+  e.f = (e.g1 > 0 && e.g2 > 0) ? std::hypot(e.g1, e.g2) : std::max(e.g1, e.g2);
+  return e;
+}
+
+/// Normal (from the field point x towards the cylinder, i.e. the direction the cylinder must move) at x.
+Vec3 cylNormalAt(const CylinderHF& C, const Vec3& x, const SdPoint& e, const Vec3& fallback) {
+  if (e.f > 0) {
+    const Real yc = std::clamp(e.y, -C.hh, C.hh);
+    const Vec3 qc = e.rho > C.r ? Vec3(e.q * (C.r / e.rho)) : e.q;
+    const Vec3 d = C.c + yc * C.w + qc - x;
+    const Real len = d.norm();
+    if (len > Real(1e-14) * (C.r + C.hh)) return d / len;
+  }
+  if (e.g1 >= e.g2) return e.rho > Real(1e-14) * C.r ? Vec3(-e.q / e.rho) : fallback;
+  return e.y >= 0 ? Vec3(-C.w) : C.w;
+}
+
+/// Parameter in [0, 1] of the point of segment p0-p1 with the least signed distance to the cylinder.
+Real minSignedDistanceOnEdge(const CylinderHF& C, const Vec3& p0, const Vec3& p1, SdPoint& best) {
+  const Vec3 e = p1 - p0, d0 = p0 - C.c;
+  const Real ye = e.dot(C.w), y0 = d0.dot(C.w);
+  const Vec3 qe = e - ye * C.w, q0 = d0 - y0 * C.w;
+  const Real qq = qe.squaredNorm(), ee = e.squaredNorm();
+  const Real s1 = qq > Real(1e-24) * ee ? std::clamp(-q0.dot(qe) / qq, Real(0), Real(1)) : Real(0.5);
+  const Real s2 = std::abs(ye) > Real(1e-12) * std::sqrt(ee) ? std::clamp(-y0 / ye, Real(0), Real(1)) : s1;
+  best = signedDistance(C, p0 + s1 * e);
+  if (best.g1 >= best.g2 && best.g2 <= 0) return s1;  // f = g1 at its minimiser
+  const SdPoint e2 = signedDistance(C, p0 + s2 * e);
+  if (e2.g2 >= e2.g1 && e2.g1 <= 0) {  // f = g2 at its minimiser
+    best = e2;
+    return s2;
+  }
+  // Golden section on the bracket (f is convex there).
+  constexpr Real kInvPhi = 0.6180339887498949;
+  Real lo = std::min(s1, s2), hi = std::max(s1, s2);
+  Real a = hi - kInvPhi * (hi - lo), b = lo + kInvPhi * (hi - lo);
+  SdPoint fa = signedDistance(C, p0 + a * e), fb = signedDistance(C, p0 + b * e);
+  for (int it = 0; it < 100 && hi - lo > Real(1e-13); ++it) {
+    if (fa.f <= fb.f) {
+      hi = b;
+      b = a;
+      fb = fa;
+      a = hi - kInvPhi * (hi - lo);
+      fa = signedDistance(C, p0 + a * e);
+    } else {
+      lo = a;
+      a = b;
+      fa = fb;
+      b = lo + kInvPhi * (hi - lo);
+      fb = signedDistance(C, p0 + b * e);
+    }
+  }
+  Real s = Real(0.5) * (lo + hi);
+  best = signedDistance(C, p0 + s * e);
+  for (const auto& cand : {std::make_pair(s1, signedDistance(C, p0 + s1 * e)), std::make_pair(s2, e2)})
+    if (cand.second.f < best.f) {
+      best = cand.second;
+      s = cand.first;
+    }
+  return s;
+}
+
+/// Is (x, y) in triangle (i, j, t)'s footprint by the grid's own partition (Grid::locate)?
+bool owns(const Grid& g, long i, long j, int t, const Vec3& p) {
+  long oi, oj;
+  int ot;
+  return g.locate(p.x(), p.y(), oi, oj, ot) && oi == i && oj == j && ot == t;
+}
+
+/// Appends unless a point at p is there already (a neighbour reported the same edge, vertex or crossing); counts
+/// either way in `found`.
+void emitCyl(std::vector<ContactPoint>& out, size_t begin, const Vec3& p, const Vec3& n, Real depth, uint32_t id,
+             int* found = nullptr) {
+  if (found) ++*found;
+  if (!nearExisting(out, begin, p)) out.push_back(makeContact(p, n, depth, id));
+}
+
+/// The points of the face (kind 0) or cap (kind 1) axis N of triangle T (see the comment above); returns how many
+/// it found, duplicates of a neighbour's included.
+int emitFaceOrCap(const Grid& g, long i, long j, int t, const Tri& T, const CylinderHF& C, int kind, const Vec3& N,
+                   const bool (&flat)[3], Real margin, size_t begin, std::vector<ContactPoint>& out) {
+  const Vec3 tv[3] = {T.a, T.b, T.c};
+  const Real nw = T.n.dot(C.w);
+  int found = 0;
+  if (kind == 1) {
+    const Vec3 cc = C.c - C.hh * N;  // centre of the cap facing the field
+    const uint32_t capIdx = N.dot(C.w) > 0 ? 0 : 1;
+    for (int m = 0; m < 3; ++m) {
+      const Vec3 d = tv[m] - cc;
+      const Real ya = N.dot(d);
+      if ((d - ya * N).norm() <= C.r && ya >= -margin)
+        emitCyl(out, begin, tv[m] - N * (Real(0.5) * ya), N, ya, T.index * 8 + localId(0x200u | uint32_t(m), 0), &found);
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (flat[k]) continue;
+      const Vec3 &p0 = tv[k], e = tv[(k + 1) % 3] - tv[k];
+      const Vec3 d0 = p0 - C.c;
+      const Vec3 q0 = d0 - d0.dot(C.w) * C.w, qe = e - e.dot(C.w) * C.w;
+      const Real A = qe.squaredNorm(), B = q0.dot(qe), Cq = q0.squaredNorm() - C.r * C.r;
+      const Real disc = B * B - A * Cq;
+      if (A <= 0 || disc < 0) continue;
+      const Real sq = std::sqrt(disc);
+      for (int root = 0; root < 2; ++root) {
+        const Real s = (-B + (root ? sq : -sq)) / A;
+        if (s <= 0 || s >= 1) continue;
+        const Vec3 x = p0 + s * e;
+        const Real ya = N.dot(x - cc);
+        if (ya >= -margin)
+          emitCyl(out, begin, x - N * (Real(0.5) * ya), N, ya,
+                  T.index * 8 + localId(0x300u | uint32_t(k), uint32_t(root)), &found);
+      }
+    }
+    const Real nN = T.n.dot(N);
+    for (int k = 0; k < kRimPoints; ++k) {
+      const Real ang = Real(6.283185307179586) * Real(k) / kRimPoints;
+      const Vec3 p = cc + C.r * (std::cos(ang) * C.ex + std::sin(ang) * C.ez);
+      const Real tt = T.n.dot(T.a - p) / nN;  // along N onto the triangle's plane
+      if (tt < -margin) continue;
+      const Vec3 x = p + tt * N;
+      bool inside = true;
+      for (int m = 0; m < 3 && inside; ++m) inside = T.n.dot((tv[(m + 1) % 3] - tv[m]).cross(x - tv[m])) >= 0;
+      if (inside)
+        emitCyl(out, begin, p + N * (Real(0.5) * tt), N, tt, T.index * 8 + localId(0x400u | capIdx, uint32_t(k)), &found);
+    }
+    return found;
+  }
+
+  // kind 0: the face.
+  const Vec3 radial = T.n - nw * C.w;
+  const Real rl = radial.norm();
+  if (rl < kUprightSin) {
+    const Real side = nw > 0 ? -1 : 1;  // the cap facing the triangle
+    const uint32_t capIdx = nw > 0 ? 0 : 1;
+    const Vec3 cc = C.c + side * C.hh * C.w;
+    for (int k = 0; k < kRimPoints; ++k) {
+      const Real ang = Real(6.283185307179586) * Real(k) / kRimPoints;
+      const Vec3 p = cc + C.r * (std::cos(ang) * C.ex + std::sin(ang) * C.ez);
+      const Real sep = T.n.dot(p - T.a);
+      if (sep > margin || !owns(g, i, j, t, p)) continue;
+      emitCyl(out, begin, p - T.n * (Real(0.5) * sep), T.n, -sep, kCylFeature | (capIdx << 3) | uint32_t(k), &found);
+    }
+    return found;
+  }
+  const Vec3 low = C.c - C.r * (radial / rl);
+  const Vec3 P0 = low - C.hh * C.w, P1 = low + C.hh * C.w;
+  // Clip the generator to the triangle's footprint (xy; counter-clockwise from above). Points within 1e-12 of the
+  // cell size outside count as inside, so an end on a shared edge or vertex is inside every triangle there and
+  // its owner (Grid::locate) reports it.
+  const Real cellTol = Real(1e-12) * (g.dx + g.dy);
+  Real tlo = 0, thi = 1;
+  int klo = -1, khi = -1;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 &v = tv[k], e = tv[(k + 1) % 3] - tv[k];
+    const Real el = std::hypot(e.x(), e.y());
+    const Real d0 = (e.x() * (P0.y() - v.y()) - e.y() * (P0.x() - v.x())) / el + cellTol;
+    const Real d1 = (e.x() * (P1.y() - v.y()) - e.y() * (P1.x() - v.x())) / el + cellTol;
+    if (d0 < 0 && d1 < 0) return found;
+    if (d0 < 0) {
+      const Real tt = d0 / (d0 - d1);
+      if (tt > tlo) tlo = tt, klo = k;
+    } else if (d1 < 0) {
+      const Real tt = d0 / (d0 - d1);
+      if (tt < thi) thi = tt, khi = k;
+    }
+  }
+  if (tlo > thi) return found;
+  const std::pair<Real, int> ends[2] = {{tlo, klo}, {thi, khi}};
+  for (int end = 0; end < 2; ++end) {
+    const auto [tt, k] = ends[end];
+    if (k >= 0 && flat[k]) continue;  // a flat join: the neighbour continues the line of contact
+    const Vec3 p = P0 + tt * (P1 - P0);
+    const Real sep = T.n.dot(p - T.a);
+    if (sep > margin) continue;
+    if (k < 0 && !owns(g, i, j, t, p)) {  // a generator end on a shared edge: its owner reports it
+      ++found;
+      continue;
+    }
+    const uint32_t id = k < 0 ? kCylFeature | 0x100u | uint32_t(end) : T.index * 8 + 1 + uint32_t(k);
+    emitCyl(out, begin, p - T.n * (Real(0.5) * sep), T.n, -sep, id, &found);
+  }
+  return found;
+}
+
+void cylinderTriangle(const Grid& g, long i, long j, int t, const CylinderHF& C, Real margin, size_t begin,
+                      std::vector<ContactPoint>& out) {
+  const Tri T = makeTri(g, i, j, t);
+  const Vec3 tv[3] = {T.a, T.b, T.c};
+  const Real tol = Real(1e-9) * (g.dx + g.dy + std::abs(T.a.z()));
+  auto triMax = [&](const Vec3& L) { return std::max({L.dot(T.a), L.dot(T.b), L.dot(T.c)}); };
+  auto beats = [](Real ov, Real best) { return ov < best - (kRelTol * std::abs(best) + kAbsTol); };
+  // 1. face
+  const Real ovN = T.n.dot(T.a) - cylMin(C, T.n);
+  if (ovN < -margin) return;
+  int kind = 0;
+  Real best = ovN;
+  Vec3 N = T.n;
+  // 2. cap
+  const Real nw = T.n.dot(C.w);
+  if (std::abs(nw) > Real(1e-9)) {
+    const Vec3 L = nw > 0 ? C.w : Vec3(-C.w);
+    const Real ov = triMax(L) - (L.dot(C.c) - C.hh);
+    if (ov < -margin) return;
+    if (beats(ov, best) && validNormal(g, i, j, t, T, L, tol)) {
+      kind = 1;
+      best = ov;
+      N = L;
+    }
+  }
+  // 3. edges (flat internal joins have no normal but the face's and separate nothing the face does not)
+  bool flat[3];
+  for (int k = 0; k < 3; ++k) flat[k] = flatJoin(g, i, j, t, T, k, tol);
+  const Real faceBest = best;
+  Real bestE = std::numeric_limits<Real>::max();
+  int kE = -1;
+  Vec3 NE = Vec3::Zero(), xE = Vec3::Zero();
+  SdPoint evE{};
+  for (int k = 0; k < 3; ++k) {
+    if (flat[k]) continue;
+    const Vec3 &p0 = tv[k], &p1 = tv[(k + 1) % 3];
+    SdPoint ev;
+    const Real s = minSignedDistanceOnEdge(C, p0, p1, ev);
+    const Vec3 x = p0 + s * (p1 - p0);
+    const Vec3 L = cylNormalAt(C, x, ev, T.n);
+    const Real tm = triMax(L);
+    const Real ov = tm - cylMin(C, L);
+    if (ov < -margin) return;
+    if (ov < bestE && L.dot(x) >= tm - tol && validNormal(g, i, j, t, T, L, tol)) {
+      bestE = ov;
+      kE = k;
+      NE = L;
+      xE = x;
+      evE = ev;
+    }
+  }
+  if (kE >= 0 && beats(bestE, faceBest)) {
+    kind = 2;
+    best = bestE;
+    N = NE;
+  }
+
+  // Edge axis (also the fallback when the face or cap axis won but its features do not overlap in projection,
+  // e.g. a rim just above a ridge: the cap's disc does not reach the ridge, the rim does).
+  auto emitEdge = [&]() {
+    const Vec3 &p0 = tv[kE], &p1 = tv[(kE + 1) % 3];
+    const Vec3 e = p1 - p0;
+    if (evE.g1 >= evE.g2 && e.cross(C.w).norm() < Real(1e-3) * e.norm()) {
+      // The edge runs along the axis (a cylinder lying along a ridge): the ends of the edge's part within the
+      // cylinder's length.
+      const Real ye = e.dot(C.w), y0 = (p0 - C.c).dot(C.w);
+      Real lo = (-C.hh - y0) / ye, hi = (C.hh - y0) / ye;
+      if (lo > hi) std::swap(lo, hi);
+      lo = std::max<Real>(lo, 0);
+      hi = std::min<Real>(hi, 1);
+      if (lo <= hi) {
+        uint32_t end = 0;
+        for (const Real s : {lo, hi}) {
+          const Vec3 x = p0 + s * e;
+          const Real d = NE.dot(x) - cylMin(C, NE);
+          if (d >= -margin) emitCyl(out, begin, x - NE * (Real(0.5) * d), NE, d, end ? T.index * 8 + 7 : T.index * 8 + 4 + uint32_t(kE));
+          ++end;
+        }
+        return;
+      }
+    }
+    emitCyl(out, begin, xE - NE * (Real(0.5) * bestE), NE, bestE, T.index * 8 + 4 + uint32_t(kE));
+  };
+  if (kind == 2) {
+    emitEdge();
+    return;
+  }
+  if (emitFaceOrCap(g, i, j, t, T, C, kind, N, flat, margin, begin, out) == 0 && kE >= 0) emitEdge();
 }
 
 }  // namespace
@@ -580,7 +849,7 @@ int collideBoxHeightField(const Shape& s0, const Transform& t0, const Shape& s1,
   thread_local Polytope P;
   makeBoxPolytope(static_cast<const Box&>(s0).getHalfExtents(), rel, P);
   const size_t begin = out.size();
-  polytopeHeightField(P, g, i0, i1, j0, j1, margin, nullptr, out);
+  polytopeHeightField(P, g, i0, i1, j0, j1, margin, out);
   return finish(out, begin, t1);
 }
 
@@ -593,7 +862,7 @@ int collideConvexHeightField(const Shape& s0, const Transform& t0, const Shape& 
   thread_local Polytope P;
   makeConvexPolytope(static_cast<const Convex&>(s0), rel, P);
   const size_t begin = out.size();
-  polytopeHeightField(P, g, i0, i1, j0, j1, margin, nullptr, out);
+  polytopeHeightField(P, g, i0, i1, j0, j1, margin, out);
   return finish(out, begin, t1);
 }
 
@@ -604,10 +873,42 @@ int collideCylinderHeightField(const Shape& s0, const Transform& t0, const Shape
   const Transform rel = t1.inverse() * t0;
   long i0, i1, j0, j1;
   if (!footprint(s0, rel, g, margin, i0, i1, j0, j1)) return 0;
-  thread_local Polytope P;
-  const CylinderPrism cp{cyl.getRadius(), Real(0.5) * cyl.getHeight(), &rel};
+  CylinderHF C;
+  C.c = rel.p;
+  C.w = rel.rotate(Vec3::UnitY());
+  C.ex = rel.rotate(Vec3::UnitX());
+  C.ez = rel.rotate(Vec3::UnitZ());
+  C.r = cyl.getRadius();
+  C.hh = Real(0.5) * cyl.getHeight();
+  const Real zlo = cylMin(C, Vec3::UnitZ());
   const size_t begin = out.size();
-  polytopeHeightField(P, g, i0, i1, j0, j1, margin, &cp, out);
+  for (long j = j0; j <= j1; ++j) {
+    for (long i = i0; i <= i1; ++i) {
+      for (int t = 0; t < 2; ++t) {
+        long vv[3][2];
+        g.triVerts(i, j, t, vv);
+        Real zhi = -std::numeric_limits<Real>::max();
+        for (const auto& p : vv) zhi = std::max(zhi, g.hf.getHeight(size_t(p[0]), size_t(p[1])));
+        if (zhi < zlo - margin) continue;
+        // Cheap cull: the cylinder's own bounding box (|x|, |z| <= r, |y| <= hh in its frame) against the
+        // triangle's vertices, one axis at a time.
+        bool apart = false;
+        for (int ax = 0; ax < 3 && !apart; ++ax) {
+          const Vec3& d = ax == 0 ? C.ex : (ax == 1 ? C.w : C.ez);
+          const Real ext = (ax == 1 ? C.hh : C.r) + margin + Real(1e-9) * (C.r + C.hh), dc = d.dot(C.c);
+          Real lo = std::numeric_limits<Real>::max(), hi = -lo;
+          for (const auto& p : vv) {
+            const Real x = d.dot(g.vert(p[0], p[1])) - dc;
+            lo = std::min(lo, x);
+            hi = std::max(hi, x);
+          }
+          apart = lo > ext || hi < -ext;
+        }
+        if (apart) continue;
+        cylinderTriangle(g, i, j, t, C, margin, begin, out);
+      }
+    }
+  }
   return finish(out, begin, t1);
 }
 
