@@ -124,10 +124,14 @@ void clipToReference(std::vector<ClipVertex>& poly, const Vec3* ref, int n, cons
     const uint8_t label = uint8_t(64 + (k & 63));
     scratch.clear();
     const size_t m = poly.size();
+    // Each vertex's distance to the side plane is computed once and carried from edge to edge (the same
+    // expression as for both ends before, so the same bits; box-box calls this for every face contact).
+    const Real d0 = sn.dot(poly[0].p) - so;
+    Real da = d0;
     for (size_t i = 0; i < m; ++i) {
       const ClipVertex& a = poly[i];
-      const ClipVertex& b = poly[(i + 1) % m];
-      const Real da = sn.dot(a.p) - so, db = sn.dot(b.p) - so;
+      const ClipVertex& b = poly[i + 1 < m ? i + 1 : 0];
+      const Real db = i + 1 < m ? sn.dot(b.p) - so : d0;
       if (da <= 0) scratch.push_back(a);
       if ((da <= 0) != (db <= 0)) {
         // The crossing lies on the polygon edge a->b (label a.out) and on the side plane.
@@ -137,6 +141,7 @@ void clipToReference(std::vector<ClipVertex>& poly, const Vec3* ref, int n, cons
         x.out = da <= 0 ? label : a.out;
         scratch.push_back(x);
       }
+      da = db;
     }
     poly.swap(scratch);
   }

@@ -76,9 +76,30 @@ void UniformGrid::findPairs(const std::vector<Aabb>& boxes, std::vector<std::pai
   finite_.clear();
   sizes_.clear();
   pairKeys_.clear();
-
-  // --- 1. classify -------------------------------------------------------------------------------------
   const uint32_t n = uint32_t(boxes.size());
+
+  // --- few boxes: every pair by AABB ------------------------------------------------------------------------
+  // Hashing, sorting and the owner-cell test cost more than n (n - 1) / 2 AABB tests for a handful of boxes
+  // (tower10's 11 geometries: the grid was 3 % of its step, docs/solver-internals.md "Fixed cost of small rigid
+  // scenes"). The loop meets the pairs in (i, j) order, so the output is the grid's, sorted, without a sort.
+  if (n <= kAllPairsMax) {
+    size_t tests = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      const Aabb& a = boxes[i];
+      if (isEmpty(a)) continue;
+      for (uint32_t j = i + 1; j < n; ++j) {
+        const Aabb& b = boxes[j];
+        if (isEmpty(b)) continue;
+        ++tests;
+        if (a.overlaps(b)) outPairs.emplace_back(i, j);
+      }
+    }
+    usedCellSize_ = 0;
+    numCellEntries_ = 0;
+    numCandidateTests_ = tests;
+    return;
+  }
+  // --- 1. classify -------------------------------------------------------------------------------------
   for (uint32_t i = 0; i < n; ++i) {
     const Aabb& b = boxes[i];
     if (isEmpty(b)) continue;

@@ -93,7 +93,7 @@ void buildContactRows(SimulationState& s) {
     manifoldFriction = manifoldFriction && block;
     // The points' offsets from the centre in the tangent plane, along the principal axes of their spread, scaled
     // so that sum(u^2) = sum(v^2) = nActive (a degenerate axis -- collinear or coincident points -- stays 0).
-    Real blockU[kMaxBlockPoints] = {}, blockV[kMaxBlockPoints] = {};
+    Real blockU[kMaxBlockPoints], blockV[kMaxBlockPoints];  // filled for the active points when block
     Vec3 arm[kMaxBlockPoints];
     Vec3 mt1 = zero, mt2 = zero;
     Real rEff = 0, sumR2 = 0;
@@ -140,6 +140,7 @@ void buildContactRows(SimulationState& s) {
     const int32_t base = int32_t(s.rows.size());
     int32_t nextFriction = base;
     int32_t nextNormal = base + int32_t(nFriction);
+    // The new rows are value-initialised here and filled in place below (setPointJacobian, contact_law.h).
     s.rows.resize(s.rows.size() + nFriction + nActive);
     s.couplings.push_back({ia, ib, uint32_t(base), nFriction + nActive, false});
     // Weight-based normal impulse estimate for box friction on new contacts: the lighter dynamic body's weight.
@@ -163,7 +164,7 @@ void buildContactRows(SimulationState& s) {
 
       // --- normal row (contact_law.h) ---
       ConstraintRow& r = s.rows[nextNormal];
-      r = pointRow(ia, ib, ra, rb, n);
+      setPointJacobian(r, ia, ib, ra, rb, n);
       r.solveType = solveType;
       const Real E = p.youngsModulus > 0 ? p.youngsModulus : mat.getYoungsModulus();
       const Real tau = p.damping >= 0 ? p.damping : mat.getDamping();
@@ -224,7 +225,7 @@ void buildContactRows(SimulationState& s) {
         for (int k = 0; k < 2; ++k) {
           const Vec3& t = k == 0 ? t1 : t2;
           ConstraintRow& f = s.rows[nextFriction + k];
-          f = pointRow(ia, ib, ra, rb, t);
+          setPointJacobian(f, ia, ib, ra, rb, t);
           f.rhs = p.surfaceVelocity.dot(t);
           f.e = eVisc;
           f.mu = mu;
@@ -253,7 +254,6 @@ void buildContactRows(SimulationState& s) {
         for (int k = 0; k < 2; ++k) {
           const Vec3& t = k == 0 ? t1 : t2;
           ConstraintRow& f = s.rows[nextFriction + k];
-          f = ConstraintRow{};
           f.bodyA = ia;
           f.bodyB = ib;
           f.jAngA = t;
@@ -276,7 +276,7 @@ void buildContactRows(SimulationState& s) {
       for (int k = 0; k < 2; ++k) {
         const Vec3& t = k == 0 ? mt1 : mt2;
         ConstraintRow& f = s.rows[base + k];
-        f = pointRow(ia, ib, centre - xa, centre - xb, t);
+        setPointJacobian(f, ia, ib, centre - xa, centre - xb, t);
         f.rhs = first->surfaceVelocity.dot(t);
         f.e = eVisc / Real(nActive);  // the points' viscous compliances act in parallel
         f.mu = mu;
@@ -290,7 +290,6 @@ void buildContactRows(SimulationState& s) {
       // Twist: torque about the normal. Point i slips at w r_i and its viscous row carries w r_i / e, a torque
       // w r_i^2 / e, so the points together give e_twist = e / sum(r_i^2) (rad/s per N m s).
       ConstraintRow& tw = s.rows[base + 2];
-      tw = ConstraintRow{};
       tw.bodyA = ia;
       tw.bodyB = ib;
       tw.jAngA = first->normal;

@@ -5,7 +5,8 @@
 // `oversizeFactor` cells along any axis (big static boxes), and infinite ones (planes), go to a separate
 // list; each of those is tested against every finite box by AABB and against the other oversize ones.
 // Candidate pairs are emitted once, as (lower index, higher index), in sorted order so results are
-// deterministic. Cost is linear in N for evenly sized objects.
+// deterministic. Cost is linear in N for evenly sized objects. Up to kAllPairsMax boxes every pair is tested
+// by AABB instead (same pairs, same order; cheaper than hashing and sorting for a handful of boxes).
 #pragma once
 
 #include <cstdint>
@@ -21,9 +22,12 @@ class UniformGrid {
   /// 0 (default) = automatic from the box sizes.
   void setCellSize(Real size);
   Real getCellSize() const { return cellSize_; }
-  /// Cell size used by the last findPairs().
+  /// Cell size used by the last findPairs() (0: it had at most kAllPairsMax boxes and used no cells).
   Real getUsedCellSize() const { return usedCellSize_; }
   void setOversizeFactor(Real f);
+
+  /// At most this many boxes: all pairs by AABB, no cells (getUsedCellSize() and getNumCellEntries() 0).
+  static constexpr uint32_t kAllPairsMax = 32;
 
   /// All pairs (i, j), i < j, whose boxes overlap, sorted. Boxes with lo > hi (empty) are skipped.
   void findPairs(const std::vector<Aabb>& boxes, std::vector<std::pair<uint32_t, uint32_t>>& outPairs);
