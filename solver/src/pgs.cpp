@@ -126,9 +126,152 @@ static bool solveClampedBlock(ConstraintRow* R, int n, const Real* resid, Real* 
   return true;
 }
 
+// The block's coordinates: D(0, i) = 1, D(1, i) = u_i, D(2, i) = v_i.
+static inline Real blockD(const ConstraintRow& r, int a) { return a == 0 ? 1.0 : a == 1 ? r.blockU : r.blockV; }
+
+// Builds the constant operators of the block whose first row is R (PgsBlocks::Block).
+static void buildBlock(const ConstraintRow* R, PgsBlocks::Block& B) {
+  const int n = R[0].blockCount;
+  Real su = 0, sv = 0;
+  for (int i = 0; i < n; ++i) {
+    su += R[i].blockU * R[i].blockU;
+    sv += R[i].blockV * R[i].blockV;
+  }
+  B.axisU = su > 0;
+  B.axisV = sv > 0;
+  for (int a = 0; a < 3; ++a) {
+    B.gLinA[a] = B.gAngA[a] = B.gLinB[a] = B.gAngB[a] = Vec3::Zero();
+    B.wLinA[a] = B.wAngA[a] = B.wLinB[a] = B.wAngB[a] = Vec3::Zero();
+    B.dRhs[a] = 0;
+    for (int i = 0; i < n; ++i) {
+      const Real d = blockD(R[i], a);
+      if (d == 0) continue;
+      B.gLinA[a] += d * R[i].jLinA;
+      B.gAngA[a] += d * R[i].jAngA;
+      B.gLinB[a] += d * R[i].jLinB;
+      B.gAngB[a] += d * R[i].jAngB;
+      B.wLinA[a] += d * R[i].mJLinA;
+      B.wAngA[a] += d * R[i].mJAngA;
+      B.wLinB[a] += d * R[i].mJLinB;
+      B.wAngB[a] += d * R[i].mJAngB;
+      B.dRhs[a] += d * R[i].rhs;
+    }
+  }
+  const bool hasA = R[0].bodyA >= 0, hasB = R[0].bodyB >= 0;
+  for (int cfg = 0; cfg < 3; ++cfg) {
+    const bool useA = hasA && cfg != 1, useB = hasB && cfg != 2;
+    // S = D (K + E) D^T = G_a . W_c (over the free bodies) + sum_i D_ai e_i D_ci.
+    Real S[3][3];
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c < 3; ++c) {
+        Real v = 0;
+        if (useA) v += B.gLinA[a].dot(B.wLinA[c]) + B.gAngA[a].dot(B.wAngA[c]);
+        if (useB) v += B.gLinB[a].dot(B.wLinB[c]) + B.gAngB[a].dot(B.wAngB[c]);
+        for (int i = 0; i < n; ++i) v += blockD(R[i], a) * R[i].e * blockD(R[i], c);
+        S[a][c] = v;
+      }
+    // A degenerate axis (collinear or coincident points) carries nothing: identity row, zero right-hand side.
+    for (int a = 1; a < 3; ++a)
+      if (!(a == 1 ? B.axisU : B.axisV)) {
+        for (int c = 0; c < 3; ++c) S[a][c] = S[c][a] = 0;
+        S[a][a] = 1;
+      }
+    Real* L = B.chol[cfg];
+    bool ok = S[0][0] > 0;
+    if (ok) {
+      L[0] = std::sqrt(S[0][0]);
+      L[1] = S[1][0] / L[0];
+      const Real p1 = S[1][1] - L[1] * L[1];
+      ok = p1 > 0;
+      if (ok) {
+        L[2] = std::sqrt(p1);
+        L[3] = S[2][0] / L[0];
+        L[4] = (S[2][1] - L[3] * L[1]) / L[2];
+        const Real p2 = S[2][2] - L[3] * L[3] - L[4] * L[4];
+        ok = p2 > 0;
+        if (ok) L[5] = std::sqrt(p2);
+      }
+    }
+    B.ok[cfg] = ok && std::isfinite(L[0] + L[1] + L[2] + L[3] + L[4] + L[5]);
+  }
+}
+
+// The block update with the operators prepared in B (see solveNormalBlock below for the law).
+static bool solvePreparedBlock(ConstraintRow* R, const PgsBlocks::Block& B, std::vector<SolverBodyState>& bodies,
+                               int frozen, Real& change) {
+  const int cfg = frozen < 0 ? 0 : frozen == 0 ? 1 : 2;
+  if (!B.ok[cfg]) return false;
+  const int n = R[0].blockCount;
+  const int32_t ia = R[0].bodyA, ib = R[0].bodyB;
+  const bool useA = frozen != 0 && ia >= 0, useB = frozen != 1 && ib >= 0;
+  Real b[3] = {B.dRhs[0], B.dRhs[1], B.dRhs[2]};
+  if (ia >= 0) {
+    const Vec3 v = bodies[ia].v, w = bodies[ia].w;
+    for (int a = 0; a < 3; ++a) b[a] -= B.gLinA[a].dot(v) + B.gAngA[a].dot(w);
+  }
+  if (ib >= 0) {
+    const Vec3 v = bodies[ib].v, w = bodies[ib].w;
+    for (int a = 0; a < 3; ++a) b[a] -= B.gLinB[a].dot(v) + B.gAngB[a].dot(w);
+  }
+  for (int i = 0; i < n; ++i) {
+    const Real el = R[i].e * R[i].lambda;
+    b[0] -= el;
+    b[1] -= el * R[i].blockU;
+    b[2] -= el * R[i].blockV;
+  }
+  if (!B.axisU) b[1] = 0;
+  if (!B.axisV) b[2] = 0;
+  const Real* L = B.chol[cfg];
+  // L y = b, L^T dmu = y.
+  const Real y0 = b[0] / L[0];
+  const Real y1 = (b[1] - L[1] * y0) / L[2];
+  const Real y2 = (b[2] - L[3] * y0 - L[4] * y1) / L[5];
+  Real dmu[3];
+  dmu[2] = y2 / L[5];
+  dmu[1] = (y1 - L[4] * dmu[2]) / L[2];
+  dmu[0] = (y0 - L[1] * dmu[1] - L[3] * dmu[2]) / L[0];
+  if (!std::isfinite(dmu[0] + dmu[1] + dmu[2])) return false;
+  Real dl[kMaxNormalBlock];
+  bool inside = true;
+  for (int i = 0; i < n; ++i) {
+    dl[i] = dmu[0] + dmu[1] * R[i].blockU + dmu[2] * R[i].blockV;
+    const Real nl = R[i].lambda + dl[i];
+    inside &= nl >= R[i].lo && nl <= R[i].hi;
+  }
+  if (!inside) {
+    Real resid[kMaxNormalBlock];
+    for (int i = 0; i < n; ++i) resid[i] = R[i].rhs - rowVelocity(R[i], bodies) - R[i].e * R[i].lambda;
+    return solveClampedBlock(R, n, resid, dl, useA, useB, bodies, change);
+  }
+  Real maxD = 0;
+  for (int i = 0; i < n; ++i) {
+    R[i].lambda += dl[i];
+    maxD = std::max(maxD, std::abs(dl[i]));
+  }
+  Vec3 dvA = Vec3::Zero(), dwA = Vec3::Zero(), dvB = Vec3::Zero(), dwB = Vec3::Zero();
+  for (int a = 0; a < 3; ++a) {
+    dvA += B.wLinA[a] * dmu[a];
+    dwA += B.wAngA[a] * dmu[a];
+    dvB += B.wLinB[a] * dmu[a];
+    dwB += B.wAngB[a] * dmu[a];
+  }
+  if (useA) {
+    bodies[ia].v += dvA;
+    bodies[ia].w += dwA;
+  }
+  if (useB) {
+    bodies[ib].v += dvB;
+    bodies[ib].w += dwB;
+  }
+  change = maxD;
+  return true;
+}
+
 static bool solveNormalBlock(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, size_t begin,
-                             int frozen, Real& change) {
+                             int frozen, Real& change, const PgsBlocks* blocks) {
   ConstraintRow* R = rows.data() + begin;
+  if (blocks && R[0].blockSlot >= 0)
+    return solvePreparedBlock(R, blocks->blocks[size_t(R[0].blockSlot)], bodies, frozen, change);
   const int n = R[0].blockCount;
   const bool useA = frozen != 0 && R[0].bodyA >= 0, useB = frozen != 1 && R[0].bodyB >= 0;
   Real su = 0, sv = 0;
@@ -213,7 +356,7 @@ static bool solveNormalBlock(std::vector<ConstraintRow>& rows, std::vector<Solve
   return true;
 }
 
-void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies) {
+void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, PgsBlocks* blocks) {
   for (ConstraintRow& r : rows) {
     SCREE_ASSERT(r.bodyA < int32_t(bodies.size()) && r.bodyB < int32_t(bodies.size()));
     SCREE_VALIDATE_CHECK(r.jLinA.allFinite() && r.jAngA.allFinite() && r.jLinB.allFinite() && r.jAngB.allFinite());
@@ -228,6 +371,19 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     if (r.bodyB >= 0) k += r.jLinB.dot(r.mJLinB) + r.jAngB.dot(r.mJAngB);
     r.diag = k;
     r.invDiag = k > 0 ? 1.0 / k : 0.0;
+    r.blockSlot = -1;
+  }
+  if (blocks) {
+    size_t count = 0;
+    for (size_t i = 0; i < rows.size(); ++i)
+      if (rows[i].blockCount > 1 && rows[i].blockBegin == int32_t(i)) ++count;
+    if (blocks->blocks.size() < count) blocks->blocks.resize(count);  // grows only: storage reused across steps
+    size_t slot = 0;
+    for (size_t i = 0; i < rows.size(); ++i)
+      if (rows[i].blockCount > 1 && rows[i].blockBegin == int32_t(i)) {
+        buildBlock(rows.data() + i, blocks->blocks[slot]);
+        rows[i].blockSlot = int32_t(slot++);
+      }
   }
   for (size_t i = 0; i < rows.size(); ++i) {
     ConstraintRow& r = rows[i];
@@ -272,7 +428,8 @@ static Real solveUnit(std::vector<ConstraintRow>& rows, std::vector<SolverBodySt
   return std::abs(d);
 }
 
-Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations) {
+Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
+                        const PgsBlocks* blocks) {
   // Symmetric Gauss-Seidel: sweeps alternate forward and backward. On chains (joints, stacks) a one-way sweep
   // carries information one link per sweep in one direction only; alternating halves the propagation time and,
   // with SPOOK's stabilisation, keeps long stiff chains stable at the default iteration count where one-way
@@ -287,7 +444,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
           // A manifold's normal block (i is its first row): one block update, else its rows one by one.
           const size_t count = size_t(rows[i].blockCount);
           Real d = 0;
-          if (solveNormalBlock(rows, bodies, i, -1, d)) {
+          if (solveNormalBlock(rows, bodies, i, -1, d, blocks)) {
             maxDelta = std::max(maxDelta, d);
           } else {
             for (size_t k = i; k < i + count; ++k) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
@@ -303,7 +460,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
         if (rows[j].blockCount > 1) {
           const size_t first = size_t(rows[j].blockBegin);
           Real d = 0;
-          if (solveNormalBlock(rows, bodies, first, -1, d)) {
+          if (solveNormalBlock(rows, bodies, first, -1, d, blocks)) {
             maxDelta = std::max(maxDelta, d);
           } else {
             for (size_t k = j + 1; k-- > first;) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
@@ -342,7 +499,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
 }
 
 void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
-                          const std::vector<ShockRange>& ranges, int maxSweeps) {
+                          const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks) {
   auto solveFrozen = [&](ConstraintRow& r, int frozen, Real lo, Real hi) -> Real {
     // Diagonal with only the free body's mass.
     Real k = r.e;
@@ -373,7 +530,7 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
         // A manifold's normal block, solved as in the sweeps (solveNormalBlock) with the lower body frozen.
         const uint32_t count = uint32_t(rows[i].blockCount);
         Real d = 0;
-        if (solveNormalBlock(rows, bodies, i, sr.frozen, d)) {
+        if (solveNormalBlock(rows, bodies, i, sr.frozen, d, blocks)) {
           change = std::max(change, d);
           for (uint32_t k = i; k < i + count; ++k) scale = std::max(scale, std::abs(rows[k].lambda));
           i += count - 1;
@@ -391,7 +548,7 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
         ConstraintRow& s = rows[i + 1];
         change = std::max(change, std::abs(solveFrozen(r, sr.frozen, -lim, lim)));
         change = std::max(change, std::abs(solveFrozen(s, sr.frozen, -lim, lim)));
-        const Real mag = std::hypot(r.lambda, s.lambda);
+        const Real mag = std::sqrt(r.lambda * r.lambda + s.lambda * s.lambda);
         if (mag > lim) {
           // Project the pair back onto the disc and undo the excess on the free body.
           const Real sc = mag > 0 ? lim / mag : 0;

@@ -109,7 +109,7 @@ void rigidShock(SimulationState& s, bool onlyIterative) {
     if (r.begin >= contactEnd) continue;
     for (uint32_t i = r.begin; i < r.begin + r.count; ++i) s.sweepLambda[i] = s.rows[i].lambda;
   }
-  PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations());
+  PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations(), &s.pgsBlocks);
   for (const PgsSolver::ShockRange& r : sh) {
     if (r.begin >= contactEnd || (freeBody(r) >= 0 && s.shockSupports[freeBody(r)] > 1)) continue;
     Real added = 0;
@@ -196,11 +196,11 @@ void iterativePath(SimulationState& s, bool interleaved) {
   Real residual = 0;
   if (interleaved) {
     for (int it = 0; it < iterations; ++it) {
-      residual = PgsSolver::iterate(s.rows, s.sb, 1);
+      residual = PgsSolver::iterate(s.rows, s.sb, 1, &s.pgsBlocks);
       residual = std::max(residual, s.particles.sweep(s.granular, s.sb, it % 2 == 1));
     }
   } else {
-    if (!s.rows.empty()) residual = PgsSolver::iterate(s.rows, s.sb, iterations);
+    if (!s.rows.empty()) residual = PgsSolver::iterate(s.rows, s.sb, iterations, &s.pgsBlocks);
     if (particles)
       for (int it = 0; it < iterations; ++it)
         residual = std::max(residual, s.particles.sweep(s.granular, s.sb, it % 2 == 1));
@@ -237,7 +237,7 @@ void solve(SimulationState& s) {
   }
   const bool split = classifyRows(s, particleDirect);
   if (!s.directSet.empty()) addGeometricStiffness(s);
-  if (!s.rows.empty()) PgsSolver::prepare(s.rows, s.sb);
+  if (!s.rows.empty()) PgsSolver::prepare(s.rows, s.sb, &s.pgsBlocks);
   if (particleDirect) s.particles.loadDirectImpulses(s.rows);
   else if (particles) s.particles.prepare(s.granular, s.sb);
 
