@@ -10,7 +10,13 @@ namespace scree::detail {
 
 namespace {
 const SolverBodyState kStatic{};
-constexpr int kMaxNormalBlock = 16;  ///< most normal rows one block holds (contact_rows.cpp builds no larger)
+constexpr int kMaxNormalBlock = 16;
+/// The shock pass stops sweeping a support once its impulses move by less than this fraction of their size.
+/// A support's normal block and its friction rows converge by about 0.6 per sweep (the friction at the contact
+/// plane tilts the box, which the block then corrects), so 1e-9 took all 16 sweeps on nearly every support of
+/// pyramid20 (15.6 on average); 1e-6 takes 7.2 and leaves pyramid20's drift at 0.0143 cm against 0.0145
+/// (1e-5: 5.9 sweeps, 0.030 cm; 1e-4: 0.66 cm). docs/solver-internals.md, "Sweep cost".
+constexpr Real kShockTolerance = 1e-7;  ///< most normal rows one block holds (contact_rows.cpp builds no larger)
 
 inline Real rowVelocity(const ConstraintRow& r, const std::vector<SolverBodyState>& b) {
   Real jv = 0;
@@ -498,6 +504,127 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   return maxDelta;
 }
 
+// DESIGN (issue 18, docs/solver-internals.md "Sweep cost"): a support of the shock pass is one free body on a
+// frozen one, so a manifold's support -- its normal block's three coordinates and its centre friction pair and
+// twist -- is a 6 x 6 system on the free body's six velocities. Sweeping it converges by only about 0.6 per
+// sweep (the friction at the contact plane tilts the box, which the block then undoes), so the pass ran 11-16
+// sweeps per support; solving the six coordinates at once gives the sweeps' fixed point in one solve whenever it
+// lies inside the bounds (every normal impulse above its bound, the friction inside mu times the new normal
+// sum), as it does for resting and sliding-free supports. Otherwise (tipping, sliding, separating) the sweeps
+// run as before. Returns true when the exact update was applied.
+bool PgsSolver::solveSupportExactly(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                                    const ShockRange& sr, const PgsBlocks& blocks) {
+  constexpr int kMax = 6;
+  // The range: a manifold's friction rows (first, contact_rows.cpp) and its normal block.
+  int32_t nb = -1;
+  for (uint32_t i = sr.begin; i < sr.begin + sr.count; ++i)
+    if (rows[i].blockCount > 1) {
+      nb = rows[i].blockBegin;
+      break;
+    }
+  if (nb < 0 || rows[size_t(nb)].blockSlot < 0) return false;
+  ConstraintRow* R = rows.data() + nb;
+  const ConstraintRow& r0 = R[0];
+  const int n = r0.blockCount;
+  const int nf = int(sr.count) - n;
+  if (nf < 0 || nf > kMax - 3 || nb < int32_t(sr.begin) || nb + n > int32_t(sr.begin + sr.count)) return false;
+  ConstraintRow* F[kMax];
+  int32_t fIndex[kMax];
+  {
+    int k = 0;
+    for (uint32_t i = sr.begin; i < sr.begin + sr.count; ++i) {
+      if (int32_t(i) >= nb && int32_t(i) < nb + n) continue;
+      ConstraintRow& f = rows[i];
+      if (f.normalRow != nb || f.normalCount != n || f.bodyA != r0.bodyA || f.bodyB != r0.bodyB) return false;
+      fIndex[k] = int32_t(i);
+      F[k++] = &f;
+    }
+  }
+  const PgsBlocks::Block& B = blocks.blocks[size_t(r0.blockSlot)];
+  const bool freeA = sr.frozen != 0;
+  const int32_t fb = freeA ? r0.bodyA : r0.bodyB;
+  if (fb < 0) return false;
+  const int m = 3 + nf;
+  // Free-body Jacobians G and M^-1 G^T of the m coordinates.
+  Vec3 gl[kMax], ga[kMax], wl[kMax], wa[kMax];
+  for (int a = 0; a < 3; ++a) {
+    gl[a] = freeA ? B.gLinA[a] : B.gLinB[a];
+    ga[a] = freeA ? B.gAngA[a] : B.gAngB[a];
+    wl[a] = freeA ? B.wLinA[a] : B.wLinB[a];
+    wa[a] = freeA ? B.wAngA[a] : B.wAngB[a];
+  }
+  for (int k = 0; k < nf; ++k) {
+    const ConstraintRow& f = *F[k];
+    gl[3 + k] = freeA ? f.jLinA : f.jLinB;
+    ga[3 + k] = freeA ? f.jAngA : f.jAngB;
+    wl[3 + k] = freeA ? f.mJLinA : f.mJLinB;
+    wa[3 + k] = freeA ? f.mJAngA : f.mJAngB;
+  }
+  Eigen::Matrix<Real, kMax, kMax> K = Eigen::Matrix<Real, kMax, kMax>::Identity();
+  Eigen::Matrix<Real, kMax, 1> b = Eigen::Matrix<Real, kMax, 1>::Zero();
+  for (int a = 0; a < m; ++a)
+    for (int c = 0; c <= a; ++c) K(a, c) = K(c, a) = gl[a].dot(wl[c]) + ga[a].dot(wa[c]);
+  // Regularisation: the block's D E D^T, the friction rows' own e.
+  for (int i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c < 3; ++c) K(a, c) += blockD(R[i], a) * R[i].e * blockD(R[i], c);
+  for (int k = 0; k < nf; ++k) K(3 + k, 3 + k) += F[k]->e;
+  // Residuals (velocities of both bodies, as in the sweeps).
+  for (int a = 0; a < 3; ++a) b[a] = B.dRhs[a];
+  if (r0.bodyA >= 0)
+    for (int a = 0; a < 3; ++a) b[a] -= B.gLinA[a].dot(bodies[r0.bodyA].v) + B.gAngA[a].dot(bodies[r0.bodyA].w);
+  if (r0.bodyB >= 0)
+    for (int a = 0; a < 3; ++a) b[a] -= B.gLinB[a].dot(bodies[r0.bodyB].v) + B.gAngB[a].dot(bodies[r0.bodyB].w);
+  for (int i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) b[a] -= blockD(R[i], a) * R[i].e * R[i].lambda;
+  for (int k = 0; k < nf; ++k) {
+    const ConstraintRow& f = *F[k];
+    b[3 + k] = f.rhs - rowVelocity(f, bodies) - f.e * f.lambda;
+  }
+  // A degenerate axis carries nothing (as in the block).
+  for (int a = 1; a < 3; ++a)
+    if (!(a == 1 ? B.axisU : B.axisV)) {
+      K.row(a).setZero();
+      K.col(a).setZero();
+      K(a, a) = 1;
+      b[a] = 0;
+    }
+  const Eigen::LLT<Eigen::Matrix<Real, kMax, kMax>> llt(K);
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::Matrix<Real, kMax, 1> x = llt.solve(b);
+  if (!x.allFinite()) return false;
+  // Bounds: the new normal impulses, then the friction inside mu times their new sum.
+  Real nl[kMaxNormalBlock];
+  Real sumN = 0;
+  for (int i = 0; i < n; ++i) {
+    nl[i] = R[i].lambda + x[0] + x[1] * R[i].blockU + x[2] * R[i].blockV;
+    if (nl[i] < R[i].lo || nl[i] > R[i].hi) return false;
+    sumN += std::max<Real>(nl[i], 0);
+  }
+  Real fl[kMax];
+  for (int k = 0; k < nf; ++k) fl[k] = F[k]->lambda + x[3 + k];
+  for (int k = 0; k < nf; ++k) {
+    const ConstraintRow& f = *F[k];
+    const Real lim = frictionLimit(f.mu, sumN);
+    if (f.pairedRow >= 0) {
+      if (k + 1 >= nf || f.pairedRow != fIndex[k + 1] || fl[k] * fl[k] + fl[k + 1] * fl[k + 1] > lim * lim) return false;
+      ++k;
+    } else if (std::abs(fl[k]) > lim) {
+      return false;
+    }
+  }
+  for (int i = 0; i < n; ++i) R[i].lambda = nl[i];
+  for (int k = 0; k < nf; ++k) F[k]->lambda = fl[k];
+  Vec3 dv = Vec3::Zero(), dw = Vec3::Zero();
+  for (int a = 0; a < m; ++a) {
+    dv += wl[a] * x[a];
+    dw += wa[a] * x[a];
+  }
+  bodies[fb].v += dv;
+  bodies[fb].w += dw;
+  return true;
+}
+
 void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                           const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks) {
   auto solveFrozen = [&](ConstraintRow& r, int frozen, Real lo, Real hi) -> Real {
@@ -572,14 +699,15 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
       }
     }
   };
-  for (const ShockRange& sr : ranges)
+  for (const ShockRange& sr : ranges) {
+    if (blocks && solveSupportExactly(rows, bodies, sr, *blocks)) continue;
     for (int sweep = 0; sweep < maxSweeps; ++sweep) {
       Real change = 0, scale = 0;
       sweepRange(sr, change, scale);
-      // Converged: the support's impulses moved by less than 1e-9 of their size (a warm-started resting stack
-      // gets here after one or two sweeps).
-      if (change <= 1e-9 * scale) break;
+      // Converged: the support's impulses moved by less than kShockTolerance of their size.
+      if (change <= kShockTolerance * scale) break;
     }
+  }
 }
 
 }  // namespace scree::detail

@@ -77,6 +77,12 @@ class PgsSolver {
   /// manifold consistent, so the loop gain drops below one.
   static void shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                         const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks = nullptr);
+
+ private:
+  /// One support of the shock pass (a manifold's normal block and its centre friction rows) solved exactly on
+  /// the free body when the solution lies inside the bounds (pgs.cpp); false: nothing changed, sweep it.
+  static bool solveSupportExactly(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                                  const ShockRange& sr, const PgsBlocks& blocks);
 };
 
 }  // namespace scree::detail
