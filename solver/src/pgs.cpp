@@ -434,6 +434,48 @@ static Real solveUnit(std::vector<ConstraintRow>& rows, std::vector<SolverBodySt
   return std::abs(d);
 }
 
+// One Gauss-Seidel pass over rows [begin, end), forward or backward; a manifold's normal block is one update
+// (else its rows one by one) and a projected-cone pair one unit. Returns the largest |delta lambda|.
+static Real sweepRows(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, size_t begin,
+                      size_t end, bool forward, const PgsBlocks* blocks) {
+  Real maxDelta = 0;
+  if (forward) {
+    for (size_t i = begin; i < end; ++i) {
+      if (rows[i].blockCount > 1) {
+        // A manifold's normal block (i is its first row): one block update, else its rows one by one.
+        const size_t count = size_t(rows[i].blockCount);
+        Real d = 0;
+        if (solveNormalBlock(rows, bodies, i, -1, d, blocks)) {
+          maxDelta = std::max(maxDelta, d);
+        } else {
+          for (size_t k = i; k < i + count; ++k) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
+        }
+        i += count - 1;
+        continue;
+      }
+      maxDelta = std::max(maxDelta, solveUnit(rows, bodies, i));
+      if (rows[i].pairedRow == int32_t(i) + 1) ++i;
+    }
+  } else {
+    for (size_t j = end; j-- > begin;) {
+      if (rows[j].blockCount > 1) {
+        const size_t first = size_t(rows[j].blockBegin);
+        Real d = 0;
+        if (solveNormalBlock(rows, bodies, first, -1, d, blocks)) {
+          maxDelta = std::max(maxDelta, d);
+        } else {
+          for (size_t k = j + 1; k-- > first;) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
+        }
+        j = first;
+        continue;
+      }
+      if (j > begin && rows[j - 1].pairedRow == int32_t(j)) --j;
+      maxDelta = std::max(maxDelta, solveUnit(rows, bodies, j));
+    }
+  }
+  return maxDelta;
+}
+
 Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
                         const PgsBlocks* blocks) {
   // Symmetric Gauss-Seidel: sweeps alternate forward and backward. On chains (joints, stacks) a one-way sweep
@@ -441,44 +483,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   // with SPOOK's stabilisation, keeps long stiff chains stable at the default iteration count where one-way
   // sweeps left enough residual to feed an oscillation.
   Real maxDelta = 0;
-  const size_t n = rows.size();
-  for (int it = 0; it < iterations; ++it) {
-    maxDelta = 0;
-    if (it % 2 == 0) {
-      for (size_t i = 0; i < n; ++i) {
-        if (rows[i].blockCount > 1) {
-          // A manifold's normal block (i is its first row): one block update, else its rows one by one.
-          const size_t count = size_t(rows[i].blockCount);
-          Real d = 0;
-          if (solveNormalBlock(rows, bodies, i, -1, d, blocks)) {
-            maxDelta = std::max(maxDelta, d);
-          } else {
-            for (size_t k = i; k < i + count; ++k) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
-          }
-          i += count - 1;
-          continue;
-        }
-        maxDelta = std::max(maxDelta, solveUnit(rows, bodies, i));
-        if (rows[i].pairedRow == int32_t(i) + 1) ++i;
-      }
-    } else {
-      for (size_t j = n; j-- > 0;) {
-        if (rows[j].blockCount > 1) {
-          const size_t first = size_t(rows[j].blockBegin);
-          Real d = 0;
-          if (solveNormalBlock(rows, bodies, first, -1, d, blocks)) {
-            maxDelta = std::max(maxDelta, d);
-          } else {
-            for (size_t k = j + 1; k-- > first;) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
-          }
-          j = first;
-          continue;
-        }
-        if (j > 0 && rows[j - 1].pairedRow == int32_t(j)) --j;
-        maxDelta = std::max(maxDelta, solveUnit(rows, bodies, j));
-      }
-    }
-  }
+  for (int it = 0; it < iterations; ++it) maxDelta = sweepRows(rows, bodies, 0, rows.size(), it % 2 == 0, blocks);
   return maxDelta;
 }
 
