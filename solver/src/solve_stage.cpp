@@ -12,6 +12,11 @@
 // Every path but NOTHING starts from the warm start (PgsSolver::prepare, GranularStage::prepare) and ends with
 // the shock passes (Solver::setUseShockPropagation). Particle units in the manual's DIRECT mode become rows on
 // appended solver bodies for the HYBRID path (granular_stage.h) and are removed again after it.
+//
+// DESIGN (issue 18, sweep cost, docs/solver-internals.md "Sweep cost"): the stage keeps one PgsBlocks in the
+// simulation state and hands it to prepare, the sweeps and the shock pass, so the manifold normal blocks'
+// operators are built once per step into reused storage (pgs.cpp). The direct-set subset sweeps of the HYBRID
+// path do not use them (they solve row by row, as before).
 #include <algorithm>
 #include <limits>
 

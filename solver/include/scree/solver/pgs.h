@@ -67,7 +67,8 @@ class PgsSolver {
   /// Shock propagation (Guendelman, Bridson & Fedkiw 2003): after the sweeps, the given row ranges (ordered
   /// from the ground up) are solved in turn, each with its lower body held immovable, up to `maxSweeps`
   /// Gauss-Seidel sweeps per range (fewer once its impulses stop changing). Rows of a range are visited
-  /// normals first.
+  /// normals first. With `blocks`, a range that is one manifold (normal block and centre friction) is first solved
+  /// exactly on its free body; it is swept only when that solution leaves the bounds (pgs.cpp).
   ///
   /// Why: plain PGS with warm starting has a loop gain of about 2 from one step to the next (an impulse error
   /// e leaves a velocity error that shifts the next step's solution by e again), so the sweeps must cut the
