@@ -181,18 +181,22 @@ static void buildBlock(const ConstraintRow* R, PgsBlocks::Block& B) {
     }
   }
   const bool hasA = R[0].bodyA >= 0, hasB = R[0].bodyB >= 0;
+  // S = D (K + E) D^T = G_a . W_c (over the free bodies) + sum_i D_ai e_i D_ci: the parts of body A, of body B
+  // and of E once (symmetric), then summed per configuration.
+  Real SA[3][3], SB[3][3], SE[3][3];
+  for (int a = 0; a < 3; ++a)
+    for (int c = 0; c <= a; ++c) {
+      SA[a][c] = SA[c][a] = hasA ? B.gLinA[a].dot(B.wLinA[c]) + B.gAngA[a].dot(B.wAngA[c]) : 0.0;
+      SB[a][c] = SB[c][a] = hasB ? B.gLinB[a].dot(B.wLinB[c]) + B.gAngB[a].dot(B.wAngB[c]) : 0.0;
+      Real e = 0;
+      for (int i = 0; i < n; ++i) e += blockD(R[i], a) * R[i].e * blockD(R[i], c);
+      SE[a][c] = SE[c][a] = e;
+    }
   for (int cfg = 0; cfg < 3; ++cfg) {
-    const bool useA = hasA && cfg != 1, useB = hasB && cfg != 2;
-    // S = D (K + E) D^T = G_a . W_c (over the free bodies) + sum_i D_ai e_i D_ci.
+    const bool useA = cfg != 1, useB = cfg != 2;
     Real S[3][3];
     for (int a = 0; a < 3; ++a)
-      for (int c = 0; c < 3; ++c) {
-        Real v = 0;
-        if (useA) v += B.gLinA[a].dot(B.wLinA[c]) + B.gAngA[a].dot(B.wAngA[c]);
-        if (useB) v += B.gLinB[a].dot(B.wLinB[c]) + B.gAngB[a].dot(B.wAngB[c]);
-        for (int i = 0; i < n; ++i) v += blockD(R[i], a) * R[i].e * blockD(R[i], c);
-        S[a][c] = v;
-      }
+      for (int c = 0; c < 3; ++c) S[a][c] = SE[a][c] + (useA ? SA[a][c] : 0.0) + (useB ? SB[a][c] : 0.0);
     // A degenerate axis (collinear or coincident points) carries nothing: identity row, zero right-hand side.
     for (int a = 1; a < 3; ++a)
       if (!(a == 1 ? B.axisU : B.axisV)) {
