@@ -90,6 +90,9 @@ struct SimulationState {
   // other rows; empty when no shock pass ran. storeResults caches these instead of the solved impulses.
   std::vector<Real> sweepLambda;
   std::vector<int> shockSupports;         // per solver body: shock ranges in which it is the free body
+  // Issue 18 (solver sweep): the manifold normal blocks' operators, built by PgsSolver::prepare each step into
+  // storage kept across steps (pgs.h PgsBlocks).
+  PgsBlocks pgsBlocks;
 
   // ---- position projection: its own direct solver, so each keeps its cached symbolic analysis ---------------
   DirectSolver projector;

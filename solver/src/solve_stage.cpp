@@ -12,6 +12,11 @@
 // Every path but NOTHING starts from the warm start (PgsSolver::prepare, GranularStage::prepare) and ends with
 // the shock passes (Solver::setUseShockPropagation). Particle units in the manual's DIRECT mode become rows on
 // appended solver bodies for the HYBRID path (granular_stage.h) and are removed again after it.
+//
+// DESIGN (issue 18, sweep cost, docs/solver-internals.md "Sweep cost"): the stage keeps one PgsBlocks in the
+// simulation state and hands it to prepare, the sweeps and the shock pass, so the manifold normal blocks'
+// operators are built once per step into reused storage (pgs.cpp). The direct-set subset sweeps of the HYBRID
+// path do not use them (they solve row by row, as before).
 #include <algorithm>
 #include <limits>
 
@@ -109,7 +114,7 @@ void rigidShock(SimulationState& s, bool onlyIterative) {
     if (r.begin >= contactEnd) continue;
     for (uint32_t i = r.begin; i < r.begin + r.count; ++i) s.sweepLambda[i] = s.rows[i].lambda;
   }
-  PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations());
+  PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations(), &s.pgsBlocks);
   for (const PgsSolver::ShockRange& r : sh) {
     if (r.begin >= contactEnd || (freeBody(r) >= 0 && s.shockSupports[freeBody(r)] > 1)) continue;
     Real added = 0;
@@ -196,11 +201,11 @@ void iterativePath(SimulationState& s, bool interleaved) {
   Real residual = 0;
   if (interleaved) {
     for (int it = 0; it < iterations; ++it) {
-      residual = PgsSolver::iterate(s.rows, s.sb, 1);
+      residual = PgsSolver::iterate(s.rows, s.sb, 1, &s.pgsBlocks);
       residual = std::max(residual, s.particles.sweep(s.granular, s.sb, it % 2 == 1));
     }
   } else {
-    if (!s.rows.empty()) residual = PgsSolver::iterate(s.rows, s.sb, iterations);
+    if (!s.rows.empty()) residual = PgsSolver::iterate(s.rows, s.sb, iterations, &s.pgsBlocks);
     if (particles)
       for (int it = 0; it < iterations; ++it)
         residual = std::max(residual, s.particles.sweep(s.granular, s.sb, it % 2 == 1));
@@ -237,7 +242,7 @@ void solve(SimulationState& s) {
   }
   const bool split = classifyRows(s, particleDirect);
   if (!s.directSet.empty()) addGeometricStiffness(s);
-  if (!s.rows.empty()) PgsSolver::prepare(s.rows, s.sb);
+  if (!s.rows.empty()) PgsSolver::prepare(s.rows, s.sb, &s.pgsBlocks);
   if (particleDirect) s.particles.loadDirectImpulses(s.rows);
   else if (particles) s.particles.prepare(s.granular, s.sb);
 

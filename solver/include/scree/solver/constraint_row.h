@@ -48,6 +48,9 @@ struct ConstraintRow {
   /// axis: collinear or coincident points).
   int32_t blockBegin = -1, blockCount = 0;
   Real blockU = 0, blockV = 0;
+  /// The block's precomputed operators in PgsBlocks (set by PgsSolver::prepare on a block's first row when a
+  /// PgsBlocks is given; -1: none, the block is then assembled on every visit).
+  int32_t blockSlot = -1;
 
   // Filled by the solver's prepare step.
   Vec3 mJLinA = Vec3::Zero(), mJAngA = Vec3::Zero(), mJLinB = Vec3::Zero(), mJAngB = Vec3::Zero();  ///< M^-1 J^T

@@ -25,12 +25,35 @@ struct SolverBodyState {
   Mat3 invInertia = Mat3::Zero();
 };
 
+/// The constant operators of each manifold normal block (pgs.cpp solveNormalBlock), built once per step by
+/// PgsSolver::prepare so that a sweep's block visit is three 12-wide dot products, a 3 x 3 triangular solve and
+/// three 12-wide updates instead of assembling and factoring the 3 x 3 system on every visit (issue 18: that
+/// assembly was 60 % of pyramid20's step). Kept by the caller across steps so that its storage is reused.
+struct PgsBlocks {
+  struct Block {
+    /// Per coordinate a (centre, tilt u, tilt v): G_a = sum_i D_ai J_i (the coordinate's row), W_a = M^-1 G_a^T.
+    Vec3 gLinA[3], gAngA[3], gLinB[3], gAngB[3];
+    Vec3 wLinA[3], wAngA[3], wLinB[3], wAngB[3];
+    Real dRhs[3];  ///< sum_i D_ai rhs_i
+    /// Cholesky factor (lower, row-major packed: l00 l10 l11 l20 l21 l22) of D (K + E) D^T with both bodies
+    /// free [0], body A frozen [1], body B frozen [2]; ok[k] false when that system is not positive definite.
+    Real chol[3][6];
+    bool ok[3];
+    bool axisU, axisV;
+  };
+  std::vector<Block> blocks;
+};
+
 class PgsSolver {
  public:
-  /// Computes M^-1 J^T and the diagonals, then applies the warm-start impulses to the velocities.
-  static void prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies);
-  /// `iterations` sweeps over all rows in order. Returns the largest |delta lambda| of the last sweep.
-  static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations);
+  /// Computes M^-1 J^T and the diagonals, then applies the warm-start impulses to the velocities. With `blocks`,
+  /// also the manifold normal blocks' operators (ConstraintRow::blockSlot); without, every blockSlot is -1.
+  static void prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                      PgsBlocks* blocks = nullptr);
+  /// `iterations` sweeps over all rows in order. Returns the largest |delta lambda| of the last sweep. `blocks`
+  /// must be the one given to prepare (or null).
+  static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
+                      const PgsBlocks* blocks = nullptr);
   /// The same sweeps over the rows listed in `subset` only (ascending indices; a projected-cone pair must be
   /// listed whole); the other rows' impulses are held fixed. Used by the hybrid direct/iterative solve.
   static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
@@ -44,7 +67,8 @@ class PgsSolver {
   /// Shock propagation (Guendelman, Bridson & Fedkiw 2003): after the sweeps, the given row ranges (ordered
   /// from the ground up) are solved in turn, each with its lower body held immovable, up to `maxSweeps`
   /// Gauss-Seidel sweeps per range (fewer once its impulses stop changing). Rows of a range are visited
-  /// normals first.
+  /// normals first. With `blocks`, a range that is one manifold (normal block and centre friction) is first solved
+  /// exactly on its free body; it is swept only when that solution leaves the bounds (pgs.cpp).
   ///
   /// Why: plain PGS with warm starting has a loop gain of about 2 from one step to the next (an impulse error
   /// e leaves a velocity error that shifts the next step's solution by e again), so the sweeps must cut the
@@ -53,7 +77,13 @@ class PgsSolver {
   /// fixed removes the coupling down the stack, and sweeping each support to convergence makes its 4-point
   /// manifold consistent, so the loop gain drops below one.
   static void shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
-                        const std::vector<ShockRange>& ranges, int maxSweeps);
+                        const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks = nullptr);
+
+ private:
+  /// One support of the shock pass (a manifold's normal block and its centre friction rows) solved exactly on
+  /// the free body when the solution lies inside the bounds (pgs.cpp); false: nothing changed, sweep it.
+  static bool solveSupportExactly(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                                  const ShockRange& sr, const PgsBlocks& blocks);
 };
 
 }  // namespace scree::detail
