@@ -5,9 +5,6 @@
 #include <bit>
 #include <cmath>
 #include <sstream>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include "contact_law.h"
 #include "scree/solver/direct.h"
@@ -373,12 +370,6 @@ void GranularStage::partition(const GranularBodySystem& ps, Real cellSize) {
   slabOf_.resize(nu);
   auto& count = slabCount_;
   count.assign(size_t(numSlabs) + 2, 0);
-  // Dependency level of each slab unit (see the header, "Two-lane sweep schedule"), counted over all slab units
-  // in unit order: within a slab, two units sharing a particle get increasing levels (levels of units of
-  // other slabs only leave gaps).
-  levelOfParticle_.assign(ps.size(), 0);
-  levelOfUnit_.resize(nu);
-  uint32_t maxLevel = 0;
   for (size_t k = 0; k < nu; ++k) {
     const Unit& u = scratchUnits_[k];
     int sl;
@@ -388,56 +379,14 @@ void GranularStage::partition(const GranularBodySystem& ps, Real cellSize) {
     else sl = slabOfParticle(u.a);
     slabOf_[k] = uint16_t(sl);
     ++count[size_t(sl)];
-    uint32_t lev = 0;
-    if (sl < numSlabs) {
-      lev = levelOfParticle_[u.a];
-      if (u.b >= 0) lev = std::max(lev, levelOfParticle_[size_t(u.b)]);
-      levelOfParticle_[u.a] = lev + 1;
-      if (u.b >= 0) levelOfParticle_[size_t(u.b)] = lev + 1;
-      maxLevel = std::max(maxLevel, lev);
-    }
-    levelOfUnit_[k] = lev;
   }
   slabStart_.assign(size_t(numSlabs) + 3, 0);
   for (int sl = 0; sl <= numSlabs + 1; ++sl) slabStart_[size_t(sl) + 1] = slabStart_[size_t(sl)] + count[size_t(sl)];
-  // Groups: per slab and level, the centred units, then the others; the serial set and the DIRECT-mode units
-  // one group each, in unit order. A stable counting sort by group places the units.
-  const size_t perSlab = (size_t(maxLevel) + 1) * 2;
-  const size_t numGroups = size_t(numSlabs) * perSlab + 2;
-  auto groupOf = [&](size_t k) {
-    const size_t sl = slabOf_[k];
-    if (sl >= size_t(numSlabs)) return size_t(numSlabs) * perSlab + (sl - size_t(numSlabs));
-    return sl * perSlab + size_t(levelOfUnit_[k]) * 2 + (scratchUnits_[k].centred ? 0 : 1);
-  };
-  levelCount_.assign(numGroups + 1, 0);
-  for (size_t k = 0; k < nu; ++k) ++levelCount_[groupOf(k) + 1];
-  for (size_t g = 0; g < numGroups; ++g) levelCount_[g + 1] += levelCount_[g];
-  units_.resize(nu);
-  // Where the unit order by slab alone (the order of the plain sweep) puts each unit: the shock pass breaks
-  // ties of height in that order.
   auto& cursor = slabCursor_;
   cursor.assign(slabStart_.begin(), slabStart_.end() - 1);
-  posOfSlabOrder_.resize(nu);
-  levelOrder_.assign(levelCount_.begin(), levelCount_.end() - 1);  // group cursors
-  for (size_t k = 0; k < nu; ++k) {
-    const uint32_t pos = levelOrder_[groupOf(k)]++;
-    units_[pos] = scratchUnits_[k];
-    posOfSlabOrder_[cursor[slabOf_[k]]++] = pos;
-  }
+  units_.resize(nu);
+  for (size_t k = 0; k < nu; ++k) units_[cursor[slabOf_[k]]++] = scratchUnits_[k];
   numSlabs_ = numSlabs;
-  // The sweep items: consecutive centred units of a group in pairs, the rest alone.
-  sched_.clear();
-  schedStart_.assign(size_t(numSlabs) + 1, 0);
-  for (int sl = 0; sl < numSlabs; ++sl) {
-    for (size_t g = size_t(sl) * perSlab; g < size_t(sl + 1) * perSlab; ++g) {
-      uint32_t k = levelCount_[g];
-      const uint32_t end = levelCount_[g + 1];
-      if (g % 2 == 0)
-        for (; k + 1 < end; k += 2) sched_.push_back({k, k + 1});
-      for (; k < end; ++k) sched_.push_back({k, kNoPartner});
-    }
-    schedStart_[size_t(sl) + 1] = uint32_t(sched_.size());
-  }
 }
 
 void GranularStage::prepare(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies) {
@@ -607,144 +556,6 @@ void GranularStage::solveCentred(Unit& u, Vec3* v, Vec3* w, const Real* invM, co
   }
 }
 
-void GranularStage::solveCentredPair(Unit& u0, Unit& u1, Vec3* v, Vec3* w, const Real* invM, const Real* invI,
-                                     Real& maxDelta) const {
-#if defined(__SSE2__)
-  // solveCentred<-1> of u0 (low lane) and u1 (high lane) at once: the same operations in the same order per
-  // lane (no fused multiply-add: SSE2 has none), the branches of the scalar code as per-lane selects that keep
-  // the old value exactly where the scalar code skips an update. u0 and u1 share no particle.
-  using D = __m128d;
-  struct V { D x, y, z; };
-  auto pick = [](D mask, D yes, D no) SCREE_UNIT_INLINE { return _mm_or_pd(_mm_and_pd(mask, yes), _mm_andnot_pd(mask, no)); };
-  auto pickV = [&](D mask, const V& yes, const V& no) SCREE_UNIT_INLINE {
-    return V{pick(mask, yes.x, no.x), pick(mask, yes.y, no.y), pick(mask, yes.z, no.z)};
-  };
-  auto two = [](const Real& lo, const Real& hi) SCREE_UNIT_INLINE { return _mm_loadh_pd(_mm_load_sd(&lo), &hi); };
-  auto field = [&](Real Unit::*m) SCREE_UNIT_INLINE { return two(u0.*m, u1.*m); };
-  auto vec = [&](const Vec3& p0, const Vec3& p1) SCREE_UNIT_INLINE {
-    return V{two(p0[0], p1[0]), two(p0[1], p1[1]), two(p0[2], p1[2])};
-  };
-  auto put = [](Real& lo, Real& hi, D x) SCREE_UNIT_INLINE {
-    _mm_storel_pd(&lo, x);
-    _mm_storeh_pd(&hi, x);
-  };
-  auto putV = [&](Vec3& p0, Vec3& p1, const V& x) SCREE_UNIT_INLINE {
-    put(p0[0], p1[0], x.x);
-    put(p0[1], p1[1], x.y);
-    put(p0[2], p1[2], x.z);
-  };
-  auto dot = [](const V& p, const V& q) SCREE_UNIT_INLINE {  // (p0 q0 + p1 q1) + p2 q2, as Eigen's dot
-    return _mm_add_pd(_mm_add_pd(_mm_mul_pd(p.x, q.x), _mm_mul_pd(p.y, q.y)), _mm_mul_pd(p.z, q.z));
-  };
-  auto sub = [](const V& p, const V& q) SCREE_UNIT_INLINE {
-    return V{_mm_sub_pd(p.x, q.x), _mm_sub_pd(p.y, q.y), _mm_sub_pd(p.z, q.z)};
-  };
-  auto scale = [](D s, const V& p) SCREE_UNIT_INLINE { return V{_mm_mul_pd(s, p.x), _mm_mul_pd(s, p.y), _mm_mul_pd(s, p.z)}; };
-  auto addScaled = [](const V& p, D s, const V& q) SCREE_UNIT_INLINE {  // p + s q
-    return V{_mm_add_pd(p.x, _mm_mul_pd(s, q.x)), _mm_add_pd(p.y, _mm_mul_pd(s, q.y)), _mm_add_pd(p.z, _mm_mul_pd(s, q.z))};
-  };
-  auto subScaled = [](const V& p, D s, const V& q) SCREE_UNIT_INLINE {  // p - s q
-    return V{_mm_sub_pd(p.x, _mm_mul_pd(s, q.x)), _mm_sub_pd(p.y, _mm_mul_pd(s, q.y)), _mm_sub_pd(p.z, _mm_mul_pd(s, q.z))};
-  };
-  auto comb = [](D s, const V& p, D t, const V& q) SCREE_UNIT_INLINE {  // s p + t q
-    return V{_mm_add_pd(_mm_mul_pd(s, p.x), _mm_mul_pd(t, q.x)), _mm_add_pd(_mm_mul_pd(s, p.y), _mm_mul_pd(t, q.y)),
-             _mm_add_pd(_mm_mul_pd(s, p.z), _mm_mul_pd(t, q.z))};
-  };
-  // std::max(x, lo) = x < lo ? lo : x (keeps x's zero sign and NaN as the scalar code does).
-  auto stdMax = [&](D x, D lo) SCREE_UNIT_INLINE { return pick(_mm_cmplt_pd(x, lo), lo, x); };
-  // projectOntoDisc: scale by lim / |l| where |l|^2 > lim^2 (then |l| > 0), else keep l.
-  auto disc = [&](D& l1, D& l2, D lim) SCREE_UNIT_INLINE {
-    const D mag2 = _mm_add_pd(_mm_mul_pd(l1, l1), _mm_mul_pd(l2, l2));
-    const D over = _mm_cmpgt_pd(mag2, _mm_mul_pd(lim, lim));
-    if (_mm_movemask_pd(over) == 0) return;
-    const D s = _mm_div_pd(lim, _mm_sqrt_pd(mag2));
-    l1 = pick(over, _mm_mul_pd(l1, s), l1);
-    l2 = pick(over, _mm_mul_pd(l2, s), l2);
-  };
-  const D zero = _mm_setzero_pd();
-  const D signBit = _mm_set1_pd(-0.0);
-
-  const uint32_t a0 = u0.a, b0 = uint32_t(u0.b), a1 = u1.a, b1 = uint32_t(u1.b);
-  const D ima = two(invM[a0], invM[a1]), imb = two(invM[b0], invM[b1]);
-  const D la = field(&Unit::la), lb = field(&Unit::lb);
-  const D iia = _mm_mul_pd(two(invI[a0], invI[a1]), la), iib = _mm_mul_pd(two(invI[b0], invI[b1]), lb);
-  const V n = vec(u0.n, u1.n), t1 = vec(u0.t1, u1.t1), t2 = vec(u0.t2, u1.t2);
-  V va = vec(v[a0], v[a1]), vb = vec(v[b0], v[b1]);
-  V wa = vec(w[a0], w[a1]), wb = vec(w[b0], w[b1]);
-  D lN = field(&Unit::lN);
-  // Normal.
-  {
-    const D vn = dot(n, sub(va, vb));
-    const D eN = field(&Unit::eN), kN = field(&Unit::kN);
-    const D x = _mm_add_pd(lN, _mm_mul_pd(_mm_sub_pd(_mm_sub_pd(field(&Unit::rhsN), vn), _mm_mul_pd(eN, lN)), kN));
-    const D nl = stdMax(x, field(&Unit::loN));
-    const D d = _mm_sub_pd(nl, lN);
-    lN = nl;
-    put(u0.lN, u1.lN, nl);
-    const D moved = _mm_cmpneq_pd(d, zero);
-    const V P = scale(d, n);
-    va = pickV(moved, addScaled(va, ima, P), va);
-    vb = pickV(moved, subScaled(vb, imb, P), vb);
-    const D ad = _mm_andnot_pd(signBit, d);
-    const D md = _mm_set1_pd(maxDelta);
-    const D m2 = pick(_mm_cmplt_pd(md, ad), ad, md);  // std::max(maxDelta, |d|) per lane
-    alignas(16) Real mm[2];
-    _mm_store_pd(mm, m2);
-    maxDelta = std::max(mm[0], mm[1]);  // max is exact: the order of the lanes does not matter
-  }
-  // Friction (mu > 0), as solveCentred.
-  const D mu = field(&Unit::mu);
-  const D fric = _mm_cmpgt_pd(mu, zero);
-  const D eT = field(&Unit::eT);
-  if (_mm_movemask_pd(fric) != 0) {
-    const V dv = sub(va, vb);
-    const V L = comb(la, wa, lb, wb);
-    const D sigma = field(&Unit::sigma);
-    const D vt1 = _mm_sub_pd(dot(t1, dv), _mm_mul_pd(sigma, dot(L, t2)));
-    const D vt2 = _mm_add_pd(dot(t2, dv), _mm_mul_pd(sigma, dot(L, t1)));
-    const D lT1 = field(&Unit::lT1), lT2 = field(&Unit::lT2);
-    D l1 = _mm_add_pd(lT1, _mm_mul_pd(_mm_sub_pd(_mm_sub_pd(field(&Unit::rhsT1), vt1), _mm_mul_pd(eT, lT1)), field(&Unit::kT1)));
-    D l2 = _mm_add_pd(lT2, _mm_mul_pd(_mm_sub_pd(_mm_sub_pd(field(&Unit::rhsT2), vt2), _mm_mul_pd(eT, lT2)), field(&Unit::kT2)));
-    // frictionLimit: 1e300 for an infinite mu, else mu * max(lN, 0).
-    const D isInf = _mm_cmpeq_pd(_mm_andnot_pd(signBit, mu), _mm_set1_pd(std::numeric_limits<Real>::infinity()));
-    const D lim = pick(isInf, _mm_set1_pd(1e300), _mm_mul_pd(mu, stdMax(lN, zero)));
-    disc(l1, l2, lim);
-    const D d1 = _mm_sub_pd(l1, lT1), d2 = _mm_sub_pd(l2, lT2);
-    put(u0.lT1, u1.lT1, pick(fric, l1, lT1));
-    put(u0.lT2, u1.lT2, pick(fric, l2, lT2));
-    const D moved = _mm_and_pd(fric, _mm_or_pd(_mm_cmpneq_pd(d1, zero), _mm_cmpneq_pd(d2, zero)));
-    const V P = comb(d1, t1, d2, t2);
-    const V nxP = scale(sigma, sub(scale(d1, t2), scale(d2, t1)));  // n x P
-    va = pickV(moved, addScaled(va, ima, P), va);
-    wa = pickV(moved, subScaled(wa, iia, nxP), wa);
-    vb = pickV(moved, subScaled(vb, imb, P), vb);
-    wb = pickV(moved, subScaled(wb, iib, nxP), wb);
-  }
-  putV(v[a0], v[a1], va);
-  putV(v[b0], v[b1], vb);
-  // Rolling resistance (rollMu > 0 and kR > 0), as rollingImpulse.
-  const D rollMu = field(&Unit::rollMu), kR = field(&Unit::kR);
-  const D roll = _mm_and_pd(_mm_cmpgt_pd(rollMu, zero), _mm_cmpgt_pd(kR, zero));
-  if (_mm_movemask_pd(roll) != 0) {
-    const V wr = sub(wa, wb);
-    const D lR1 = field(&Unit::lR1), lR2 = field(&Unit::lR2);
-    D l1 = _mm_add_pd(lR1, _mm_mul_pd(_mm_sub_pd(_mm_xor_pd(dot(t1, wr), signBit), _mm_mul_pd(eT, lR1)), kR));
-    D l2 = _mm_add_pd(lR2, _mm_mul_pd(_mm_sub_pd(_mm_xor_pd(dot(t2, wr), signBit), _mm_mul_pd(eT, lR2)), kR));
-    disc(l1, l2, _mm_mul_pd(rollMu, stdMax(lN, zero)));
-    const V T = comb(_mm_sub_pd(l1, lR1), t1, _mm_sub_pd(l2, lR2), t2);
-    put(u0.lR1, u1.lR1, pick(roll, l1, lR1));
-    put(u0.lR2, u1.lR2, pick(roll, l2, lR2));
-    wa = pickV(roll, addScaled(wa, two(invI[a0], invI[a1]), T), wa);
-    wb = pickV(roll, subScaled(wb, two(invI[b0], invI[b1]), T), wb);
-  }
-  putV(w[a0], w[a1], wa);
-  putV(w[b0], w[b1], wb);
-#else
-  solveCentred<-1>(u0, v, w, invM, invI, maxDelta);
-  solveCentred<-1>(u1, v, w, invM, invI, maxDelta);
-#endif
-}
-
 Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies, bool backward) {
   auto& v = ps.velocities();
   auto& w = ps.angularVelocities();
@@ -753,20 +564,6 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
   auto one = [&](Unit& u, Real& md) SCREE_UNIT_INLINE {
     if (u.centred) solveCentred<-1>(u, v.data(), w.data(), invM.data(), invInertia_.data(), md);
     else solveUnit<-1>(u, v, w, invM, invInertia_, bodies, md);
-  };
-  auto item = [&](const SweepItem& it, Real& md) SCREE_UNIT_INLINE {
-    if (it.second == kNoPartner) one(units_[it.first], md);
-    else solveCentredPair(units_[it.first], units_[it.second], v.data(), w.data(), invM.data(), invInertia_.data(), md);
-  };
-  // A slab's scheduled items (buildSchedule), or a plain range of units (the serial set).
-  auto runSlab = [&](int sl) {
-    Real md = 0;
-    const uint32_t b0 = schedStart_[size_t(sl)], b1 = schedStart_[size_t(sl) + 1];
-    if (!backward)
-      for (uint32_t k = b0; k < b1; ++k) item(sched_[k], md);
-    else
-      for (uint32_t k = b1; k-- > b0;) item(sched_[k], md);
-    return md;
   };
   auto runRange = [&](uint32_t b0, uint32_t b1) {
     Real md = 0;
@@ -780,7 +577,7 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
   const uint32_t serialBegin = slabStart_[size_t(S)], serialEnd = slabStart_[size_t(S) + 1];
   if (backward) maxDelta = std::max(maxDelta, runRange(serialBegin, serialEnd));
   if (S == 1) {
-    maxDelta = std::max(maxDelta, runSlab(0));
+    maxDelta = std::max(maxDelta, runRange(slabStart_[0], slabStart_[1]));
   } else {
     // Two phases (even slabs, then odd; reversed when sweeping backward), each slab a serial Gauss-Seidel run:
     // slabs of one phase share no particle, so which thread runs which slab does not change any bit.
@@ -790,7 +587,7 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
 #pragma omp for schedule(dynamic, 1) reduction(max : maxDelta)
       for (int j = 0; j < (S - parity + 1) / 2; ++j) {
         const int sl = backward ? S - 1 - ((S - 1 - parity) % 2) - 2 * j : parity + 2 * j;
-        maxDelta = std::max(maxDelta, runSlab(sl));
+        maxDelta = std::max(maxDelta, runRange(slabStart_[size_t(sl)], slabStart_[size_t(sl) + 1]));
       }
     }
   }
@@ -804,24 +601,21 @@ void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyStat
   const auto& x = ps.positions();
   const auto& r = ps.radii();
   shockOrder_.clear();
-  // Units in slab order (posOfSlabOrder_): equal heights keep that order, as before the level order.
-  for (uint32_t q = 0; q < iterativeEnd(); ++q) {
-    const uint32_t k = posOfSlabOrder_[q];
+  for (uint32_t k = 0; k < iterativeEnd(); ++k) {
     const Unit& u = units_[k];
     if (u.kN == 0) continue;  // inert (destroyed particle)
     if (u.b < 0) {
       // Geometry side: only static or kinematic geometry acts as a support here (side B is never moved).
       if (u.body >= 0 && bodies[size_t(u.body)].invMass > 0) continue;
-      shockOrder_.push_back({heightKey(x[u.a].dot(up) - 2 * r[u.a]), q * 2 + 1});
+      shockOrder_.push_back({heightKey(x[u.a].dot(up) - 2 * r[u.a]), k * 2 + 1});
       continue;
     }
     if (std::abs(u.n.dot(up)) <= 0.3) continue;
     const Real ha = x[u.a].dot(up), hb = x[size_t(u.b)].dot(up);
     // Freeze the lower particle.
-    shockOrder_.push_back(ha < hb ? std::make_pair(heightKey(ha), q * 2 + 0) : std::make_pair(heightKey(hb), q * 2 + 1));
+    shockOrder_.push_back(ha < hb ? std::make_pair(heightKey(ha), k * 2 + 0) : std::make_pair(heightKey(hb), k * 2 + 1));
   }
   sortByHeight(shockOrder_, shockScratch_);
-  for (auto& e : shockOrder_) e.second = posOfSlabOrder_[e.second >> 1] * 2 + (e.second & 1);
   auto& v = ps.velocities();
   auto& w = ps.angularVelocities();
   Real unused = 0;
@@ -991,11 +785,7 @@ void GranularStage::storeResults(const GranularBodySystem& ps, const ParticleCon
   const Real invH = 1.0 / h;
   ppCache_.clear();
   pgCache_.clear();
-  // In slab order (posOfSlabOrder_), not in the sweep's level order: next step's buildRows reads the entries
-  // of consecutive contacts, which are then close in memory.
-  const size_t nIter = iterativeEnd();
-  for (size_t q = 0; q < units_.size(); ++q) {
-    const Unit& u = units_[q < nIter ? posOfSlabOrder_[q] : q];
+  for (const Unit& u : units_) {
     if (!ps.isAliveDense(u.a) || (u.b >= 0 && !ps.isAliveDense(size_t(u.b)))) continue;
     const Vec3 F = u.lT1 * u.t1 + u.lT2 * u.t2;
     const Vec3 T = u.lR1 * u.t1 + u.lR2 * u.t2;

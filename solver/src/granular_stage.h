@@ -189,26 +189,6 @@ class GranularStage {
   void solveCentred(Unit& u, Vec3* v, Vec3* w, const Real* invM, const Real* invI, Real& maxDelta) const;
   void partition(const GranularBodySystem& ps, Real cellSize);
 
-  // ---- Two-lane sweep schedule (iterative sweep; docs/terrain.md, "Digging cost") ------------------------------
-  // Each slab's units are put in dependency levels: a unit's level is one more than the highest level of the
-  // slab's earlier units sharing a particle with it. Units of one level share no particle, and two units that
-  // share one keep their order, so sweeping level by level gives the slab's Gauss-Seidel result bit for bit.
-  // partition places each slab's units in level order (per level the centred units first) and pairs
-  // consecutive centred units of a level; each pair is swept by solveCentredPair (one unit per SIMD lane, the
-  // same operations as solveCentred<-1> per lane); other units run alone.
-  struct SweepItem {
-    uint32_t first;
-    uint32_t second;  // kNoPartner: `first` runs alone
-  };
-  static constexpr uint32_t kNoPartner = 0xffffffffu;
-  /// solveCentred<-1> of two centred units that share no particle, one per lane.
-  void solveCentredPair(Unit& u0, Unit& u1, Vec3* v, Vec3* w, const Real* invM, const Real* invI,
-                        Real& maxDelta) const;
-  std::vector<SweepItem> sched_;      // the slabs' items, slab by slab (the serial set is not scheduled)
-  std::vector<uint32_t> schedStart_;  // [numSlabs + 1] ranges into sched_
-  std::vector<uint32_t> levelOfParticle_, levelOfUnit_, levelCount_, levelOrder_;
-  std::vector<uint32_t> posOfSlabOrder_;  // [units] position in units_ of the q-th unit in slab order
-
   std::vector<Unit> units_;          // all units: the slabs in order, then the serial set, then DIRECT mode
   // [numSlabs + 3] ranges into units_: numSlabs slabs, the serial set, the DIRECT-mode units.
   std::vector<uint32_t> slabStart_;
