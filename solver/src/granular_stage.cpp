@@ -619,8 +619,18 @@ void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyStat
   auto& v = ps.velocities();
   auto& w = ps.angularVelocities();
   Real unused = 0;
+  // The units are visited in height order, i.e. scattered over units_ (8 MB in the trench bench, beyond the
+  // L2 cache): the unit a few visits ahead is prefetched (no effect on results).
+  constexpr size_t kAhead = 8;
+  const size_t nOrder = shockOrder_.size();
   for (int s = 0; s < sweeps; ++s)
-    for (const auto& [key, code] : shockOrder_) {
+    for (size_t i = 0; i < nOrder; ++i) {
+      if (i + kAhead < nOrder) {
+        const char* p = reinterpret_cast<const char*>(&units_[shockOrder_[i + kAhead].second >> 1]);
+        for (size_t off = 0; off < sizeof(Unit); off += 64) __builtin_prefetch(p + off, 1);
+        __builtin_prefetch(p + sizeof(Unit) - 1, 1);
+      }
+      const uint32_t code = shockOrder_[i].second;
       Unit& u = units_[code >> 1];
       if (u.centred) {
         if (code & 1) solveCentred<1>(u, v.data(), w.data(), ps.invMasses().data(), invInertia_.data(), unused);
