@@ -215,7 +215,7 @@ class GranularStage {
   // (height of the lower side as an order-preserving key, unit * 2 + frozen side), and the radix sort's buffer.
   std::vector<std::pair<uint64_t, uint32_t>> shockOrder_, shockScratch_;
   std::vector<CacheEntry> ppCache_, pgCache_;
-  std::vector<CacheKey> ppKeys_, pgKeys_;
+  std::vector<CacheKey> ppKeys_, pgKeys_, keyScratch_;
   // DIRECT mode, valid between appendDirectRows and finishDirect.
   size_t rowBase_ = 0, bodyBase_ = 0;  // sizes of rows / bodies before the append
   std::vector<int32_t> extBody_;       // [size()] solver body of a particle, -1 none
