@@ -1,6 +1,6 @@
 // Terrain: gathering the contacts' normal loads onto the grid vertices (terrain.h, "Line contacts are line
 // loads"). A point's load is split onto the three vertices of its triangle by barycentric weights; the points of
-// one generator line of a lying cylinder or capsule are read as the line load between the line's end points, a
+// a lying cylinder's or capsule's contact are read as one line load along its axis over their axial extent, a
 // linear density (no tension: the middle-third rule) integrated exactly against the barycentric weights of every
 // triangle the segment crosses.
 #include <algorithm>
@@ -50,8 +50,6 @@ struct LineDensity {
 
 struct LoadedPoint {
   Vec3 q;       ///< height-field frame
-  Vec3 world;   ///< world point
-  Vec3 normal;  ///< world contact normal
   Real load = 0, E = 0;
 };
 
@@ -82,7 +80,7 @@ void Terrain::gatherContactLoads(const GeometryContact& c, int self) {
     const Real nz = T.rotateInverse(p.normal).z();
     const Real load = p.normalForce * (self == 1 ? nz : -nz);
     if (!(load > 0)) continue;
-    pts.push_back(LoadedPoint{T.applyInverse(p.point), p.point, p.normal, load,
+    pts.push_back(LoadedPoint{T.applyInverse(p.point), load,
                               p.youngsModulus > 0 ? p.youngsModulus : Ec});
   }
   const Geometry* other = c.geometry(1 - self);
@@ -93,50 +91,38 @@ void Terrain::gatherContactLoads(const GeometryContact& c, int self) {
     for (const LoadedPoint& p : pts) depositPoint(p.q, p.load, p.E);
     return;
   }
-  // Generator lines: points in the same direction from the axis (the axis is the shape's local y).
+  // A lying cylinder or capsule (axis within 60 degrees of the field's plane): its loaded points are read as one
+  // line load along the axis, over the points' axial extent, on the line through their force centroid parallel
+  // to the axis (so the total and the moment about every horizontal line are the points').
   const Transform& G = other->getTransform();
-  const Vec3 axis = G.rotate(Vec3::UnitY()), centre = G.p;
-  const Real cosTol = std::cos(Real(0.02));
-  std::vector<Vec3> dir(pts.size());
+  const Vec3 axis = T.rotateInverse(G.rotate(Vec3::UnitY())), centre = T.applyInverse(G.p);
+  if (std::abs(axis.z()) > Real(0.5)) {
+    for (const LoadedPoint& p : pts) depositPoint(p.q, p.load, p.E);
+    return;
+  }
+  Real F = 0, K = 0, lo = 0, hi = 0;
+  Vec3 g = Vec3::Zero();
   std::vector<Real> along(pts.size());
   for (size_t i = 0; i < pts.size(); ++i) {
-    const Vec3 r = pts[i].world - centre;
-    along[i] = r.dot(axis);
-    const Vec3 perp = r - along[i] * axis;
-    const Real n = perp.norm();
-    dir[i] = n > 0 ? Vec3(perp / n) : Vec3::Zero();
+    along[i] = (pts[i].q - centre).dot(axis);
+    lo = i == 0 ? along[i] : std::min(lo, along[i]);
+    hi = i == 0 ? along[i] : std::max(hi, along[i]);
+    F += pts[i].load, K += pts[i].E;
+    g += pts[i].load * pts[i].q;
   }
-  std::vector<char> used(pts.size(), 0);
-  std::vector<size_t> group;
+  const Real len = hi - lo;
+  if (!(len > 1e-9 * (1 + std::abs(lo) + std::abs(hi)))) {
+    for (const LoadedPoint& p : pts) depositPoint(p.q, p.load, p.E);
+    return;
+  }
+  g /= F;
+  Real Ft = 0, Kt = 0;
   for (size_t i = 0; i < pts.size(); ++i) {
-    if (used[i]) continue;
-    used[i] = 1;
-    group.assign(1, i);
-    if (dir[i].squaredNorm() > 0)
-      for (size_t j = i + 1; j < pts.size(); ++j)
-        if (!used[j] && dir[j].squaredNorm() > 0 && dir[i].dot(dir[j]) >= cosTol) {
-          used[j] = 1;
-          group.push_back(j);
-        }
-    size_t lo = group[0], hi = group[0];
-    for (size_t k : group) {
-      if (along[k] < along[lo]) lo = k;
-      if (along[k] > along[hi]) hi = k;
-    }
-    const Real len = along[hi] - along[lo];
-    if (group.size() < 2 || !(len > 0)) {
-      for (size_t k : group) depositPoint(pts[k].q, pts[k].load, pts[k].E);
-      continue;
-    }
-    // Total and centroid (in t = (along - along_lo) / len) of the loads and of the stiffnesses.
-    Real F = 0, Ft = 0, K = 0, Kt = 0;
-    for (size_t k : group) {
-      const Real t = (along[k] - along[lo]) / len;
-      F += pts[k].load, Ft += pts[k].load * t;
-      K += pts[k].E, Kt += pts[k].E * t;
-    }
-    spreadLine(pts[lo].q, pts[hi].q, F, Ft / F, K, K > 0 ? Kt / K : Real(0.5));
+    const Real t = (along[i] - lo) / len;
+    Ft += pts[i].load * t, Kt += pts[i].E * t;
   }
+  const Real gAlong = (g - centre).dot(axis);
+  spreadLine(g + (lo - gAlong) * axis, g + (hi - gAlong) * axis, F, Ft / F, K, K > 0 ? Kt / K : Real(0.5));
 }
 
 void Terrain::spreadLine(const Vec3& A, const Vec3& B, Real F, Real tF, Real K, Real tK) {
