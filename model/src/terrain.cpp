@@ -314,29 +314,12 @@ void Terrain::postStep() {
   updateShovelStats();  // digging force and fill read-outs (terrain_shovel.cpp)
 
   // 1. Gather each contact point's normal load (along the field's +z) and normal stiffness (the point's Young's
-  //    modulus, N/m) onto the vertices of its triangle, by barycentric weights.
-  const Transform& T = geometry_->getTransform();
+  //    modulus, N/m) onto the vertices of its triangle, by barycentric weights; the points of a cylinder's or
+  //    capsule's line of contact as a line load over the segment between them (terrain_line_load.cpp).
   for (const GeometryContact& c : sim->getContacts()) {
     const int self = c.geometry(0) == geometry_.get() ? 0 : (c.geometry(1) == geometry_.get() ? 1 : -1);
     if (self < 0 || !c.isEnabled() || c.isSensor()) continue;
-    const Real Ec = c.material().getYoungsModulus();
-    for (const ContactPoint& p : c.points()) {
-      if (!p.enabled || !(p.normalForce > 0)) continue;
-      // The normal points from geometry 1 to geometry 0; the terrain is pressed along -normal when it is 1.
-      const Real nz = T.rotateInverse(p.normal).z();
-      const Real load = p.normalForce * (self == 1 ? nz : -nz);
-      if (!(load > 0)) continue;
-      const Real E = p.youngsModulus > 0 ? p.youngsModulus : Ec;
-      size_t v[3];
-      Real w[3];
-      if (!locate(T.applyInverse(p.point), v, w)) continue;
-      for (int k = 0; k < 3; ++k) {
-        if (!(w[k] > 0)) continue;
-        if (load_[v[k]] == 0) loaded_.push_back(v[k]);
-        load_[v[k]] += w[k] * load;
-        stiffness_[v[k]] += w[k] * E;
-      }
-    }
+    gatherContactLoads(c, self);
   }
   numLoaded_ = loaded_.size();
 
@@ -412,7 +395,11 @@ void Terrain::postStep() {
     // Our own edits are booked already; clearing lets the next step tell external edits apart.
     heightField_->clearDirtyRectangle();
   }
-  for (size_t v : loaded_) load_[v] = stiffness_[v] = 0;
+  lastLoads_.clear();
+  for (size_t v : loaded_) {
+    lastLoads_.push_back(VertexLoad{v % nx_, v / nx_, load_[v], stiffness_[v]});
+    load_[v] = stiffness_[v] = 0;
+  }
   loaded_.clear();
   // 4. Deformers push the soil they overlap (terrain_deform.cpp), arming avalanches.
   deformStep();

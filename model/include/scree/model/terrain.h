@@ -70,6 +70,33 @@
 // elastic excess (F_v - p0 A M) / K_v per step (and at most D log2(1 + maxChange / M) / ((d+1) log2 M)). The
 // plastic sinkage is the height lost; the body rests an elastic F_v / (E m) deeper.
 //
+// Line contacts are line loads (model/src/terrain_line_load.cpp). A lying cylinder (a wheel) or capsule touches
+// a plane-like field along a generator line, and the narrowphase reports that line by its two end points (at the
+// tire's side edges; docs/terrain.md "Wheels on the height field"). Splitting those two point forces onto the
+// triangles under the points would compress the soil only under the side edges, while the manual's per-vertex
+// compression (25.1.2.1) describes the ground under what rests on it: a wheel compresses the soil under its whole
+// width, as the rut it leaves shows. So the loaded points of one contact of a lying cylinder or capsule (axis
+// within 60 degrees of the field's plane; two or more points) are read as one line load along the axis, over the
+// points' axial extent, on the line through their force centroid parallel to the axis: a linear density q(t),
+// t in [0, 1], whose total and moment equal the points' (sum F_i and sum F_i t_i: a linear density with those two
+// is unique), so the total and the moment about every horizontal line are kept. Why the whole contact and not
+// each generator line's end points alone: once the soil under a wheel is a rut, its line of contact comes in
+// pieces (one per triangle, the joins no longer flat) with points on the rut's walls, and the narrowphase keeps
+// the 4 deepest points, which need not be the line's ends (measured: a 1 m cylinder then sank 17.6-23.3 mm along
+// its length, end rows as deep as the middle; read as one line over the contact's extent, 21.9-22.7 mm). Two
+// different end forces F0, F1 give q(0) = 4 F0 - 2 F1, q(1) = 4 F1 - 2 F0 (per unit t). Soil carries no tension:
+// when the resultant lies outside the segment's middle third (q would go negative at one end), the density is
+// the triangle that starts at zero inside the segment and keeps the same total and resultant (the "middle third"
+// rule of a footing's bearing pressure). The points' normal stiffnesses are spread the same way (total sum E_i,
+// centroid sum E_i t_i), so every vertex under the line gets F_v / K_v = the points' elastic deflection and yields
+// by the same implicit rule. The density is integrated exactly against the barycentric weights of every
+// triangle the segment's footprint crosses (the weights are linear along the segment between crossings of grid
+// lines and diagonals, q too between its own kink, so Simpson's rule on each piece is exact): the per-vertex loads
+// add up to the points' load and their moment about any point equals the points' moment, to rounding. Points of
+// other shapes (a sphere's one point, boxes' face corners, convex hulls), single points and deformer contacts are
+// split at the point as before. Not done: a box's or an upright cylinder's 4-point face patch still loads the
+// triangles under its corners only.
+//
 // Contact stiffness. A contact listener (contacts of any geometry with the terrain geometry) sets each point's
 // Young's modulus to E * m, m interpolated barycentrically from the three vertices under the point, E the
 // contact's (or the point's earlier override). The material of the nearest of those vertices picks the contact
@@ -615,6 +642,17 @@ class Terrain : public Model {
   /// Vertices loaded by contacts in the last step, and how many of them yielded.
   size_t getNumLoadedVertices() const { return numLoaded_; }
   size_t getNumYieldedVertices() const { return numYielded_; }
+
+  // --- per-vertex loads of the last step (line loads, terrain_line_load.cpp) ----------------------------------
+  /// One vertex's share of the contacts' normal load in the last step (before averaging): force along the
+  /// field's +z (N) and normal stiffness (N/m), at grid vertex (x, y).
+  struct VertexLoad {
+    size_t x = 0, y = 0;
+    Real force = 0, stiffness = 0;
+  };
+  /// Every vertex loaded by contacts in the last step (the loads the yield law reads, before averaging).
+  const std::vector<VertexLoad>& getLastStepVertexLoads() const { return lastLoads_; }
+  // --- end per-vertex loads ----------------------------------------------------------------------------------
   /// Wall-clock time of the terrain's own work in the last step (its pre-collide listener - digging: shovels,
   /// the cut, particle creation and merging - and its contact and post-step listeners), s.
   double getLastStepTime() const { return lastPreCollideTime_ + lastContactTime_ + lastPostTime_; }
@@ -651,6 +689,19 @@ class Terrain : public Model {
   /// The FAQ warning: a terrain particle touching a geometry whose material is not external (once per material).
   void checkParticleContacts(const std::vector<ParticleContact>& particleGeometry);
 
+  // --- line loads (terrain_line_load.cpp) ---
+  /// Adds force f and stiffness k to vertex v's load of this step (listing it in loaded_ on its first load).
+  void addVertexLoad(size_t v, Real f, Real k);
+  /// Splits one point's load (height-field frame point q) onto its triangle's vertices by barycentric weights.
+  void depositPoint(const Vec3& q, Real load, Real E);
+  /// Gathers the loads of one contact with the terrain (self: the terrain's index in it): the points of a lying
+  /// cylinder or capsule as one line load along its axis, every other point at the point.
+  void gatherContactLoads(const GeometryContact& c, int self);
+  /// The line load from A to B (height-field frame): force F with resultant at tF, stiffness K with centroid at
+  /// tK (t in [0, 1] from A to B), each a non-negative linear density, integrated against the weights exactly.
+  void spreadLine(const Vec3& A, const Vec3& B, Real F, Real tF, Real K, Real tK);
+  std::vector<VertexLoad> lastLoads_;
+  // --- end line loads ---
   /// Lowers vertex v by dz > 0 as compression: height, c (and m), and the ledger's heightField -> compressed.
   void compressVertex(size_t v, Real dz, Real newMultiplier, Real dc);
   /// Books direct HeightField edits (dirty rectangle) into the heightField account.
