@@ -1,8 +1,11 @@
 // Digging force against the fundamental earthmoving equation (FEE; docs/terrain.md, "Digging force against the
 // fundamental earthmoving equation"; scene: bench/scenes/terrain_fee.h). A flat kinematic blade is pushed 0.3 m at
 // constant depth d and speed through cohesionless terrain that digs into particles, for d = 3, 5, 7 cm, widths
-// w = 0.2, 0.3 m and rakes 45 and 60 degrees; the mean horizontal force over the second half of the push is
-// compared with the FEE's gamma d^2 w N_gamma sin(alpha + delta).
+// w = 0.2, 0.3 m and rakes 45 and 60 degrees, the cut taking the FEE failure wedge (Terrain::setShovelFailureWedge).
+// Two measures of the horizontal force are compared with the FEE's gamma d^2 w N_gamma sin(alpha + delta): the
+// mean over the second half of the push (wedge + the dug soil pushed so far, the FEE's surcharge term) and F0, the
+// force extrapolated to zero travel from the least-squares line F(s) = F0 + k_s s (the wedge term alone; k_s s is
+// the pile's, reported in the messages).
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -24,6 +27,8 @@ constexpr Real kWidths[2] = {0.2, 0.3};
 struct Study {
   Real force[2][2][3] = {};  // [rake][width][depth], N
   Real fee[2][2][3] = {};
+  Real force0[2][2][3] = {};  // F0 (N): the line's intercept
+  Real slope[2][2][3] = {};   // k_s (N/m)
   Real worstLedger = 0;
 };
 
@@ -42,11 +47,14 @@ const Study& study() {
           p.depth = kDepths[j];
           const TerrainFeeResult r = runTerrainFee(p);
           out.force[a][k][j] = r.meanForce;
+          out.force0[a][k][j] = r.force0;
+          out.slope[a][k][j] = r.pileSlope;
           out.fee[a][k][j] = feeHorizontalForce(p.rake, phi, delta, p.density * 9.81, p.depth, p.width);
           out.worstLedger = std::max(out.worstLedger, r.ledgerDrift);
           MESSAGE("rake " << kRakes[a] << " deg, w " << kWidths[k] << " m, d " << kDepths[j] << " m: F = "
                           << r.meanForce << " N, FEE = " << out.fee[a][k][j] << " N, ratio "
-                          << r.meanForce / out.fee[a][k][j]);
+                          << r.meanForce / out.fee[a][k][j] << "; F0 = " << r.force0 << " N (F0 / FEE "
+                          << r.force0 / out.fee[a][k][j] << "), k_s = " << r.pileSlope << " N/m");
         }
     setNumThreads(0);
     return out;
@@ -82,6 +90,12 @@ TEST_CASE("FEE factors: McKyes' worked case and Rankine's passive coefficient") 
   const Real kp = std::pow(std::tan(45 * deg + 17.5 * deg), 2);
   CHECK(r.nGamma == doctest::Approx(kp / 2).epsilon(1e-9));
   CHECK(r.beta / deg == doctest::Approx(27.5).epsilon(1e-6));
+  // The model's own search (Terrain::failureWedgeAngle, the cut's failure plane) finds the same beta*.
+  CHECK(Terrain::failureWedgeAngle(60 * deg, 35 * deg, 20 * deg) == doctest::Approx(f.beta).epsilon(1e-8));
+  CHECK(Terrain::failureWedgeAngle(90 * deg, 35 * deg, 0) == doctest::Approx(27.5 * deg).epsilon(1e-8));
+  CHECK_THROWS_AS(Terrain::failureWedgeAngle(NAN, 0.6, 0.3), std::invalid_argument);
+  CHECK_THROWS_AS(Terrain::failureWedgeAngle(1.0, 2.0, 0.3), std::invalid_argument);
+  CHECK_THROWS_AS(Terrain::failureWedgeAngle(1.0, 0.6, -0.1), std::invalid_argument);
   // Horizontal draft of the worked case, gamma = 16 kN/m^3, d = 0.2 m, w = 1 m: 1146.9 N.
   CHECK(feeHorizontalForce(60 * deg, 35 * deg, 20 * deg, 16e3, 0.2, 1.0) == doctest::Approx(1146.9).epsilon(1e-4));
 }
@@ -104,20 +118,27 @@ TEST_CASE("FEE digging-force study: force proportional to width, within a factor
       const Real ratio = s.force[a][k][1] / s.fee[a][k][1];
       CHECK_MESSAGE(ratio >= 0.5, "rake " << kRakes[a] << ", w " << kWidths[k] << ": F / FEE = " << ratio);
       CHECK_MESSAGE(ratio <= 2.0, "rake " << kRakes[a] << ", w " << kWidths[k] << ": F / FEE = " << ratio);
+      // The wedge term alone, F0 (zero travel: no dug soil pushed yet), within the same factor 2 of the FEE
+      // without surcharge. Measured 0.61-0.74 (docs/terrain.md); without the failure wedge it was 0.02-0.25 at
+      // this depth (the cut cleared the ground ahead at no cost), so this fails if the wedge is not taken.
+      const Real r0 = s.force0[a][k][1] / s.fee[a][k][1];
+      CHECK_MESSAGE(r0 >= 0.5, "rake " << kRakes[a] << ", w " << kWidths[k] << ": F0 / FEE = " << r0);
+      CHECK_MESSAGE(r0 <= 2.0, "rake " << kRakes[a] << ", w " << kWidths[k] << ": F0 / FEE = " << r0);
     }
   }
 }
 
-// The issue's bound on the depth exponent does not hold (docs/terrain.md, "Re-measured, and where the linear term
-// comes from": 1.56-1.73; the force grows about linearly with travel, with the dug soil gathered in front of the
-// blade, and extrapolated to zero travel it is 0.02-0.5 of the FEE: the cut removes the soil ahead of the edge
-// without failing a wedge, so the FEE's d^2 term is missing and the pile's, linear in d, dominates). Skipped, not
-// loosened: run it with --no-skip to see the fitted exponents.
+// The issue's bound on the depth exponent, applied to the wedge term F0 (docs/terrain.md, "The failure wedge":
+// the window mean also holds the pile of dug soil, the FEE's surcharge term, linear in d, so its exponent is not
+// the FEE's d^2 one; it is printed too). Does not hold at 60 degrees: F0's exponents 2.06, 1.88 (45 degrees) and
+// 1.50, 1.40 (60 degrees). Skipped, not loosened: run it with --no-skip to see the fitted exponents.
 TEST_CASE("FEE digging-force study: fitted exponent of d is 2 +- 0.4" * doctest::skip()) {
   const Study& s = study();
   for (int a = 0; a < 2; ++a)
     for (int k = 0; k < 2; ++k) {
-      const Real e = depthExponent(s.force[a][k]);
+      const Real e = depthExponent(s.force0[a][k]);
+      MESSAGE("rake " << kRakes[a] << ", w " << kWidths[k] << ": exponent of F0 " << e << ", of the window mean "
+                      << depthExponent(s.force[a][k]));
       CHECK_MESSAGE(std::abs(e - 2) <= 0.4, "rake " << kRakes[a] << ", w " << kWidths[k] << ": exponent " << e);
     }
 }
