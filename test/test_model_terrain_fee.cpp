@@ -12,10 +12,12 @@
 
 #include "scenes/terrain_fee.h"
 #include "scree/core/parallel.h"
+#include "terrain_world.h"
 #include "test_world.h"
 
 using namespace scree;
 using namespace scree::scenes;
+using namespace scree::test;
 
 namespace {
 
@@ -141,4 +143,56 @@ TEST_CASE("FEE digging-force study: fitted exponent of d is 2 +- 0.4" * doctest:
                       << depthExponent(s.force[a][k]));
       CHECK_MESSAGE(std::abs(e - 2) <= 0.4, "rake " << kRakes[a] << ", w " << kWidths[k] << ": exponent " << e);
     }
+}
+
+// The failure wedge's geometry (terrain.h, "The failure wedge"), one step of a resting blade: ahead of the lead
+// the ground is lowered to the plane rising at beta* from the box's lowest point at the lead's front, and left
+// alone beyond it; the ledger holds; with the option off nothing ahead of the lead is touched.
+TEST_CASE("failure wedge: the cut follows the FEE failure plane ahead of the lead") {
+  for (const bool on : {false, true}) {
+    TestWorld w(1.0 / 100, 9.81, 0.7);
+    w.material->setFrictionCoefficient(0.7);
+    TerrainRef t = addFlatTerrain(w, 51, 1.0);  // 0.02 m cells, surface at z = 0, x and y in [-0.5, 0.5]
+    t->getParticleAttributes().setParticleRadius(0.01);
+    t->setShovelFailureWedge(on);
+    CHECK(t->getShovelFailureWedge() == on);
+    auto steel = std::make_shared<Material>("blade");
+    steel->setFrictionCoefficient(0.19);
+    w.sim->getMaterialManager().getOrCreateContactMaterial(steel, w.material)->setFrictionCoefficient(0.364);
+    const Real rake = 60 * kPi / 180, d = 0.05, len = 0.4, width = 0.2, thick = 0.002;
+    auto body = std::make_shared<RigidBody>("blade");
+    auto blade = std::make_shared<Geometry>(std::make_shared<Box>(Vec3(0.5 * len, 0.5 * width, 0.5 * thick)), "blade");
+    blade->setMaterial(steel);
+    blade->getPropertyContainer().addPropertyVec3(Terrain::ShovelUpProperty, Vec3(0, 0, thick));
+    blade->getPropertyContainer().addPropertyVec3(Terrain::ShovelForwardProperty, Vec3(0.5 * len, 0, 0));
+    body->add(blade);
+    body->setMotionControl(RigidBody::KINEMATICS);
+    const Quat q(Eigen::AngleAxis<Real>(rake, Vec3::UnitY()));
+    const Vec3 tip(-0.2, 0, -d);
+    body->setRotation(q);
+    body->setPosition(tip - q * Vec3(0.5 * len, 0, 0));
+    w.sim->add(body);
+    const Real total0 = t->getVolumeLedger().total();
+    w.sim->stepForward();
+    CHECK(std::abs(t->getVolumeLedger().total() - total0) <= 1e-9 * total0);
+    blade->updateTransform();
+    const Real low = blade->getBoundingBox().lo.z();
+    const Real lead = 0.02 + 2 * 0.01;
+    const Real beta = Terrain::failureWedgeAngle(rake, std::atan(0.7), std::atan(0.364));
+    const HeightField& hf = *t->getHeightField();
+    int checked = 0, lowered = 0;
+    for (size_t i = 0; i < 51; ++i) {
+      const Real x = -0.5 + 0.02 * Real(i), xi = x - tip.x();
+      if (!(xi > lead + 1e-9)) continue;  // the wedge region only (the box and lead are the plain cut's)
+      const size_t j = 25;                  // y = 0, the blade's middle
+      const Real z = hf.getHeight(i, j) - 0.5;  // the field sits at z = -0.5 (addFlatTerrain)
+      const Real expect = on ? std::min<Real>(0, low + (xi - lead) * std::tan(beta)) : 0;
+      CHECK_MESSAGE(z == doctest::Approx(expect).epsilon(1e-12), "x " << x << ": z " << z << ", expected " << expect);
+      ++checked;
+      if (expect < 0) ++lowered;
+    }
+    CHECK(checked > 10);
+    if (on) CHECK(lowered >= 3);  // d cot(beta*) = 9.4 cm: the wedge spans several cells
+    if (on) CHECK(t->getLastStepDigStats().particlesCreated > 0);
+  }
 }

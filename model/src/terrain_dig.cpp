@@ -223,15 +223,16 @@ void Terrain::cut(const Shovel& s) {
   // on the side of the cutting edge, so the rigid wall of uncut ground stands clear of the edge.
   Real loX = s.loX, hiX = s.hiX, loY = s.loY, hiY = s.hiY;
   const Real lead = std::max(dx_, dy_) + 2 * particleAttributes_.getParticleRadius();
-  Real ex = s.tipL.x() - 0.5 * (s.loX + s.hiX), ey = s.tipL.y() - 0.5 * (s.loY + s.hiY);
-  const Real len = std::hypot(ex, ey);
+  const Real exR = s.tipL.x() - 0.5 * (s.loX + s.hiX), eyR = s.tipL.y() - 0.5 * (s.loY + s.hiY);
+  const Real len = std::hypot(exR, eyR);
+  Real ex = 0, ey = 0;  // unit horizontal direction to the edge
   // The failure wedge (terrain.h, "The failure wedge"): a plain shovel (not a deformer) with a horizontal
   // direction to its edge also cuts the soil above the FEE failure plane, which rises at beta* from the lead's
   // front up to the height of the shovel's box top; that soil becomes particles in front of the shovel.
   Real tanBeta = 0, reach = 0;
   const bool wedge = failureWedge_ && len > 0 && !isGeometryDeformer(*s.geometry);
   if (len > 0) {
-    ex /= len, ey /= len;
+    ex = exR / len, ey = eyR / len;
     if (wedge) {
       const size_t ti = size_t(std::clamp<long long>(std::llround((s.tipL.x() - x0) / dx_), 0, (long long)nx_ - 1));
       const size_t tj = size_t(std::clamp<long long>(std::llround((s.tipL.y() - y0) / dy_), 0, (long long)ny_ - 1));
@@ -260,8 +261,8 @@ void Terrain::cut(const Shovel& s) {
       }
       reach = std::max<Real>(0, boxHighL - s.boxLowL) / tanBeta;
     }
-    (ex > 0 ? hiX : loX) += (lead + reach) * ex;
-    (ey > 0 ? hiY : loY) += (lead + reach) * ey;
+    (exR > 0 ? hiX : loX) += (lead + reach) * exR / len;  // reach = 0: the lead alone, as without the wedge
+    (eyR > 0 ? hiY : loY) += (lead + reach) * eyR / len;
   }
   const long long i0 = std::max<long long>(0, clampIndex((loX - x0) / dx_, nx_) + 1);
   const long long i1 = std::min<long long>((long long)nx_ - 1, clampIndex((hiX - x0) / dx_, nx_));

@@ -253,7 +253,8 @@
 // blade pushes wedge between the blade and that wall and jam, loading the blade with forces that grew with the
 // solver's iterations and with smaller time steps (a 1 cm blade in the FEE study gave 33, 50 and 88 N for 30 and
 // 60 iterations and half the step, docs/terrain.md); with the wall a particle diameter clear of the edge they rise instead
-// (10.3, 10.8, 14.1 N), as loosened soil in front of a real blade does. Particles are made over the box only (below):
+// (10.3, 10.8, 14.1 N), as loosened soil in front of a real blade does. Particles are made over the box only (below;
+// with the failure wedge on, over the whole cut):
 // the lead's volume stays pending until the box passes over it (where a shovel stops, the trench runs a lead
 // further than the box went and that strip stays pending). Each footprint
 // vertex whose height lies above the cutting plane - and above the box's lowest point: the shovel never cuts
