@@ -3,10 +3,12 @@
 // depths, two widths and two rake angles (bench/scenes/terrain_fee.h; docs/terrain.md, "Digging force against the
 // fundamental earthmoving equation").
 //
-//   build/examples/terrain_fee_study [DIR [TRAVEL]]   prints the table; with DIR writes DIR/fee.dat (one line per
-//   setting: rake_deg depth width force fee fee_surcharge soil_volume) and DIR/fee_series.dat (travel, horizontal
+//   build/examples/terrain_fee_study [DIR [TRAVEL [WEDGE]]]   prints the table; with DIR writes DIR/fee.dat (one line per
+//   setting: rake_deg depth width force fee fee_surcharge soil_volume force0 pile_slope) and DIR/fee_series.dat (travel, horizontal
 //   and vertical force, heap top, particles and the force's 10-step running mean of every step of every setting, blocks separated by two blank lines);
-//   docs/terrain/fee.gp plots them. TRAVEL (m, default 0.3) changes the push length.
+//   docs/terrain/fee.gp plots them. TRAVEL (m, default 0.3) changes the push length; WEDGE 0 turns the cut's
+//   failure wedge off (Terrain::setShovelFailureWedge). F0 and k_s: the line F(s) = F0 + k_s s through the force
+//   at travel s > 0.05 m (TerrainFeeResult::force0, pileSlope).
 //
 // FEE+q: the FEE with the surcharge q = gamma V / (w L), V the soil the particles carry (mean over the window),
 // L = d (cot alpha + cot beta) the length of the failure wedge's top surface: all dug soil laid on the wedge,
@@ -35,12 +37,13 @@ int main(int argc, char** argv) {
   const Real g = 9.81;
   TerrainFeeParams base;
   if (argc > 2) base.travel = std::atof(argv[2]);
+  if (argc > 3) base.failureWedge = std::atoi(argv[3]) != 0;  // 0: the cut without the failure wedge
   const Real phi = std::atan(base.soilFriction), delta = std::atan(base.bladeFriction);
   std::printf("phi = %.2f deg, delta = %.2f deg, gamma = %.0f N/m^3\n", phi * 180 / M_PI, delta * 180 / M_PI,
               base.density * g);
-  std::printf("%6s %6s %6s %10s %10s %10s %10s %8s %8s %8s\n", "rake", "d", "w", "F (N)", "FEE (N)", "FEE+q (N)",
-              "soil (m3)", "F/FEE", "F/FEE+q", "time(s)");
-  if (table) std::fprintf(table, "# rake_deg depth_m width_m force_N fee_N fee_surcharge_N soil_volume_m3\n");
+  std::printf("%6s %6s %6s %10s %10s %10s %10s %8s %8s %8s %8s %8s\n", "rake", "d", "w", "F (N)", "FEE (N)", "FEE+q (N)",
+              "soil (m3)", "F/FEE", "F/FEE+q", "F0 (N)", "k_s(N/m)", "time(s)");
+  if (table) std::fprintf(table, "# rake_deg depth_m width_m force_N fee_N fee_surcharge_N soil_volume_m3 force0_N pile_slope_N_per_m\n");
   for (Real rake : rakes)
     for (Real w : widths)
       for (Real d : depths) {
@@ -57,10 +60,11 @@ int main(int argc, char** argv) {
         const Real wedge = d * (1 / std::tan(p.rake) + 1 / std::tan(ff.beta));
         const Real q = gamma * r.meanSoilVolume / (w * wedge);
         const Real feeQ = feeHorizontalForce(p.rake, phi, delta, gamma, d, w, q);
-        std::printf("%6.0f %6.3f %6.2f %10.2f %10.2f %10.2f %10.5f %8.2f %8.2f %8.1f\n", rake, d, w, r.meanForce, fee,
-                    feeQ, r.meanSoilVolume, r.meanForce / fee, r.meanForce / feeQ, secs);
+        std::printf("%6.0f %6.3f %6.2f %10.2f %10.2f %10.2f %10.5f %8.2f %8.2f %8.2f %8.1f %8.1f\n", rake, d, w, r.meanForce, fee,
+                    feeQ, r.meanSoilVolume, r.meanForce / fee, r.meanForce / feeQ, r.force0, r.pileSlope, secs);
         if (table)
-          std::fprintf(table, "%g %g %g %g %g %g %g\n", rake, d, w, r.meanForce, fee, feeQ, r.meanSoilVolume);
+          std::fprintf(table, "%g %g %g %g %g %g %g %g %g\n", rake, d, w, r.meanForce, fee, feeQ, r.meanSoilVolume,
+                       r.force0, r.pileSlope);
         if (series) {
           std::fprintf(series, "# rake %g depth %g width %g\n", rake, d, w);
           // Last column: the horizontal force's running mean over 10 steps (particles are made in batches every

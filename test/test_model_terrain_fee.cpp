@@ -1,18 +1,23 @@
 // Digging force against the fundamental earthmoving equation (FEE; docs/terrain.md, "Digging force against the
 // fundamental earthmoving equation"; scene: bench/scenes/terrain_fee.h). A flat kinematic blade is pushed 0.3 m at
 // constant depth d and speed through cohesionless terrain that digs into particles, for d = 3, 5, 7 cm, widths
-// w = 0.2, 0.3 m and rakes 45 and 60 degrees; the mean horizontal force over the second half of the push is
-// compared with the FEE's gamma d^2 w N_gamma sin(alpha + delta).
+// w = 0.2, 0.3 m and rakes 45 and 60 degrees, the cut taking the FEE failure wedge (Terrain::setShovelFailureWedge).
+// Two measures of the horizontal force are compared with the FEE's gamma d^2 w N_gamma sin(alpha + delta): the
+// mean over the second half of the push (wedge + the dug soil pushed so far, the FEE's surcharge term) and F0, the
+// force extrapolated to zero travel from the least-squares line F(s) = F0 + k_s s (the wedge term alone; k_s s is
+// the pile's, reported in the messages).
 #include <doctest/doctest.h>
 
 #include <cmath>
 
 #include "scenes/terrain_fee.h"
 #include "scree/core/parallel.h"
+#include "terrain_world.h"
 #include "test_world.h"
 
 using namespace scree;
 using namespace scree::scenes;
+using namespace scree::test;
 
 namespace {
 
@@ -24,6 +29,8 @@ constexpr Real kWidths[2] = {0.2, 0.3};
 struct Study {
   Real force[2][2][3] = {};  // [rake][width][depth], N
   Real fee[2][2][3] = {};
+  Real force0[2][2][3] = {};  // F0 (N): the line's intercept
+  Real slope[2][2][3] = {};   // k_s (N/m)
   Real worstLedger = 0;
 };
 
@@ -42,11 +49,14 @@ const Study& study() {
           p.depth = kDepths[j];
           const TerrainFeeResult r = runTerrainFee(p);
           out.force[a][k][j] = r.meanForce;
+          out.force0[a][k][j] = r.force0;
+          out.slope[a][k][j] = r.pileSlope;
           out.fee[a][k][j] = feeHorizontalForce(p.rake, phi, delta, p.density * 9.81, p.depth, p.width);
           out.worstLedger = std::max(out.worstLedger, r.ledgerDrift);
           MESSAGE("rake " << kRakes[a] << " deg, w " << kWidths[k] << " m, d " << kDepths[j] << " m: F = "
                           << r.meanForce << " N, FEE = " << out.fee[a][k][j] << " N, ratio "
-                          << r.meanForce / out.fee[a][k][j]);
+                          << r.meanForce / out.fee[a][k][j] << "; F0 = " << r.force0 << " N (F0 / FEE "
+                          << r.force0 / out.fee[a][k][j] << "), k_s = " << r.pileSlope << " N/m");
         }
     setNumThreads(0);
     return out;
@@ -82,6 +92,12 @@ TEST_CASE("FEE factors: McKyes' worked case and Rankine's passive coefficient") 
   const Real kp = std::pow(std::tan(45 * deg + 17.5 * deg), 2);
   CHECK(r.nGamma == doctest::Approx(kp / 2).epsilon(1e-9));
   CHECK(r.beta / deg == doctest::Approx(27.5).epsilon(1e-6));
+  // The model's own search (Terrain::failureWedgeAngle, the cut's failure plane) finds the same beta*.
+  CHECK(Terrain::failureWedgeAngle(60 * deg, 35 * deg, 20 * deg) == doctest::Approx(f.beta).epsilon(1e-8));
+  CHECK(Terrain::failureWedgeAngle(90 * deg, 35 * deg, 0) == doctest::Approx(27.5 * deg).epsilon(1e-8));
+  CHECK_THROWS_AS(Terrain::failureWedgeAngle(NAN, 0.6, 0.3), std::invalid_argument);
+  CHECK_THROWS_AS(Terrain::failureWedgeAngle(1.0, 2.0, 0.3), std::invalid_argument);
+  CHECK_THROWS_AS(Terrain::failureWedgeAngle(1.0, 0.6, -0.1), std::invalid_argument);
   // Horizontal draft of the worked case, gamma = 16 kN/m^3, d = 0.2 m, w = 1 m: 1146.9 N.
   CHECK(feeHorizontalForce(60 * deg, 35 * deg, 20 * deg, 16e3, 0.2, 1.0) == doctest::Approx(1146.9).epsilon(1e-4));
 }
@@ -104,18 +120,79 @@ TEST_CASE("FEE digging-force study: force proportional to width, within a factor
       const Real ratio = s.force[a][k][1] / s.fee[a][k][1];
       CHECK_MESSAGE(ratio >= 0.5, "rake " << kRakes[a] << ", w " << kWidths[k] << ": F / FEE = " << ratio);
       CHECK_MESSAGE(ratio <= 2.0, "rake " << kRakes[a] << ", w " << kWidths[k] << ": F / FEE = " << ratio);
+      // The wedge term alone, F0 (zero travel: no dug soil pushed yet), within the same factor 2 of the FEE
+      // without surcharge. Measured 0.61-0.74 (docs/terrain.md); without the failure wedge it was 0.02-0.25 at
+      // this depth (the cut cleared the ground ahead at no cost), so this fails if the wedge is not taken.
+      const Real r0 = s.force0[a][k][1] / s.fee[a][k][1];
+      CHECK_MESSAGE(r0 >= 0.5, "rake " << kRakes[a] << ", w " << kWidths[k] << ": F0 / FEE = " << r0);
+      CHECK_MESSAGE(r0 <= 2.0, "rake " << kRakes[a] << ", w " << kWidths[k] << ": F0 / FEE = " << r0);
     }
   }
 }
 
-// The issue's bound on the depth exponent does not hold (docs/terrain.md: measured 1.50-1.65; the soil the blade
-// has already dug accumulates in front of it and adds a force linear in d). Skipped, not loosened: run it with
-// --no-skip to see the fitted exponents.
+// The issue's bound on the depth exponent, applied to the wedge term F0 (docs/terrain.md, "The failure wedge":
+// the window mean also holds the pile of dug soil, the FEE's surcharge term, linear in d, so its exponent is not
+// the FEE's d^2 one; it is printed too). Does not hold at 60 degrees: F0's exponents 2.06, 1.88 (45 degrees) and
+// 1.50, 1.40 (60 degrees). Skipped, not loosened: run it with --no-skip to see the fitted exponents.
 TEST_CASE("FEE digging-force study: fitted exponent of d is 2 +- 0.4" * doctest::skip()) {
   const Study& s = study();
   for (int a = 0; a < 2; ++a)
     for (int k = 0; k < 2; ++k) {
-      const Real e = depthExponent(s.force[a][k]);
+      const Real e = depthExponent(s.force0[a][k]);
+      MESSAGE("rake " << kRakes[a] << ", w " << kWidths[k] << ": exponent of F0 " << e << ", of the window mean "
+                      << depthExponent(s.force[a][k]));
       CHECK_MESSAGE(std::abs(e - 2) <= 0.4, "rake " << kRakes[a] << ", w " << kWidths[k] << ": exponent " << e);
     }
+}
+
+// The failure wedge's geometry (terrain.h, "The failure wedge"), one step of a resting blade: ahead of the lead
+// the ground is lowered to the plane rising at beta* from the box's lowest point at the lead's front, and left
+// alone beyond it; the ledger holds; with the option off nothing ahead of the lead is touched.
+TEST_CASE("failure wedge: the cut follows the FEE failure plane ahead of the lead") {
+  for (const bool on : {false, true}) {
+    TestWorld w(1.0 / 100, 9.81, 0.7);
+    w.material->setFrictionCoefficient(0.7);
+    TerrainRef t = addFlatTerrain(w, 51, 1.0);  // 0.02 m cells, surface at z = 0, x and y in [-0.5, 0.5]
+    t->getParticleAttributes().setParticleRadius(0.01);
+    t->setShovelFailureWedge(on);
+    CHECK(t->getShovelFailureWedge() == on);
+    auto steel = std::make_shared<Material>("blade");
+    steel->setFrictionCoefficient(0.19);
+    w.sim->getMaterialManager().getOrCreateContactMaterial(steel, w.material)->setFrictionCoefficient(0.364);
+    const Real rake = 60 * kPi / 180, d = 0.05, len = 0.4, width = 0.2, thick = 0.002;
+    auto body = std::make_shared<RigidBody>("blade");
+    auto blade = std::make_shared<Geometry>(std::make_shared<Box>(Vec3(0.5 * len, 0.5 * width, 0.5 * thick)), "blade");
+    blade->setMaterial(steel);
+    blade->getPropertyContainer().addPropertyVec3(Terrain::ShovelUpProperty, Vec3(0, 0, thick));
+    blade->getPropertyContainer().addPropertyVec3(Terrain::ShovelForwardProperty, Vec3(0.5 * len, 0, 0));
+    body->add(blade);
+    body->setMotionControl(RigidBody::KINEMATICS);
+    const Quat q(Eigen::AngleAxis<Real>(rake, Vec3::UnitY()));
+    const Vec3 tip(-0.2, 0, -d);
+    body->setRotation(q);
+    body->setPosition(tip - q * Vec3(0.5 * len, 0, 0));
+    w.sim->add(body);
+    const Real total0 = t->getVolumeLedger().total();
+    w.sim->stepForward();
+    CHECK(std::abs(t->getVolumeLedger().total() - total0) <= 1e-9 * total0);
+    blade->updateTransform();
+    const Real low = blade->getBoundingBox().lo.z();
+    const Real lead = 0.02 + 2 * 0.01;
+    const Real beta = Terrain::failureWedgeAngle(rake, std::atan(0.7), std::atan(0.364));
+    const HeightField& hf = *t->getHeightField();
+    int checked = 0, lowered = 0;
+    for (size_t i = 0; i < 51; ++i) {
+      const Real x = -0.5 + 0.02 * Real(i), xi = x - tip.x();
+      if (!(xi > lead + 1e-9)) continue;  // the wedge region only (the box and lead are the plain cut's)
+      const size_t j = 25;                  // y = 0, the blade's middle
+      const Real z = hf.getHeight(i, j) - 0.5;  // the field sits at z = -0.5 (addFlatTerrain)
+      const Real expect = on ? std::min<Real>(0, low + (xi - lead) * std::tan(beta)) : 0;
+      CHECK_MESSAGE(z == doctest::Approx(expect).epsilon(1e-12), "x " << x << ": z " << z << ", expected " << expect);
+      ++checked;
+      if (expect < 0) ++lowered;
+    }
+    CHECK(checked > 10);
+    if (on) CHECK(lowered >= 3);  // d cot(beta*) = 9.4 cm: the wedge spans several cells
+    if (on) CHECK(t->getLastStepDigStats().particlesCreated > 0);
+  }
 }

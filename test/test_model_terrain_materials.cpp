@@ -326,7 +326,9 @@ DirectRun carryDirectLump(int settle) {
 }  // namespace
 
 // Does not hold yet (docs/terrain.md, "External materials and particle solve type"): the dug lump does not stay
-// rigid - measured drift 0.34 m (1e4 m before speculative pairs stopped being glued), up to 399 pivots in a step.
+// rigid - measured drift 0.34 m (1e4 m before speculative pairs stopped being glued), up to 399 pivots in a step;
+// 2.5e4 m and 23 pivots after issue 18's contact changes: the lump has no support in the step it is made, its landing
+// on the stiff blade exceeds the direct solve's pivot cap, and the PGS fallback throws it apart.
 // Skipped, not counted as passing.
 TEST_CASE("particle friction solve type DIRECT: a dug lump carried by the bucket moves as one body" * doctest::skip()) {
   const DirectRun r = carryDirectLump(15);

@@ -70,6 +70,7 @@ TerrainFeeResult runTerrainFee(const TerrainFeeParams& p) {
   s.sim->add(terrain);
   terrain->getDataInterface().add(soil, 0, 0.0, 0.0);  // non-deformable: no compression under the heap
   terrain->getParticleAttributes().setParticleRadius(p.radius);
+  terrain->setShovelFailureWedge(p.failureWedge);
 
   // The blade: a plate, local +x down its slope to the cutting edge, local +z its soil-facing normal. Rotated by
   // alpha about +y, local x -> (cos alpha, 0, -sin alpha), local z -> (sin alpha, 0, cos alpha): it leans back by
@@ -131,6 +132,19 @@ TerrainFeeResult runTerrainFee(const TerrainFeeParams& p) {
   out.meanForce = nWin ? sumF / nWin : 0;
   out.meanHeapHeight = nWin ? sumH / nWin : 0;
   out.meanSoilVolume = nWin ? sumV / nWin : 0;
+  {
+    Real n = 0, ms = 0, mf = 0;
+    for (const TerrainFeeSample& x : out.samples)
+      if (x.travel > 0.05) n += 1, ms += x.travel, mf += x.force;
+    if (n > 1) {
+      ms /= n, mf /= n;
+      Real sxy = 0, sxx = 0;
+      for (const TerrainFeeSample& x : out.samples)
+        if (x.travel > 0.05) sxy += (x.travel - ms) * (x.force - mf), sxx += (x.travel - ms) * (x.travel - ms);
+      out.pileSlope = sxx > 0 ? sxy / sxx : 0;
+      out.force0 = mf - out.pileSlope * ms;
+    }
+  }
   return out;
 }
 

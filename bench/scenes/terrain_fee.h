@@ -45,6 +45,7 @@ struct TerrainFeeParams {
   Real youngsModulus = 1e7;   ///< N/m per contact point, soil and blade
   Real dt = 1.0 / 100;
   int iterations = 30;        ///< PGS iterations (rigid and particle sweeps)
+  bool failureWedge = true;   ///< Terrain::setShovelFailureWedge: the cut takes the FEE failure wedge
 };
 
 struct TerrainFeeSample {
@@ -61,6 +62,11 @@ struct TerrainFeeResult {
   Real meanForce = 0;       ///< mean horizontal force over the second half of the travel, N
   Real meanHeapHeight = 0;  ///< mean heap height over the same window, m
   Real meanSoilVolume = 0;  ///< mean soil volume in particles over the same window, m^3
+  /// Least-squares line F(s) = force0 + pileSlope s through every step's horizontal force at travel s > 0.05 m:
+  /// force0 is the force of a blade that has gathered no dug soil yet (the FEE's gamma d^2 w N_gamma term),
+  /// pileSlope s the part that grows with the soil it pushes (the FEE's surcharge term), docs/terrain.md.
+  Real force0 = 0;          ///< N
+  Real pileSlope = 0;       ///< N/m
   Real ledgerDrift = 0;     ///< largest relative change of the volume ledger's total
 };
 

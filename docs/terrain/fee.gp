@@ -6,12 +6,12 @@ set output "docs/terrain/fee.png"
 set multiplot layout 1,2
 f = "docs/terrain/fee.dat"
 sel(r, w, v) = ($1 == r && abs($3 - w) < 1e-9) ? v : 1/0
-set title "Mean horizontal force vs depth (points: Terrain; dashed: FEE)" noenhanced
+set title "Horizontal force vs depth (filled: window mean; open: F0; dashed: FEE)" noenhanced
 set xlabel "cutting depth d (m)"
 set ylabel "horizontal force (N)"
 set logscale xy
 set xrange [0.025:0.08]
-set yrange [3:70]
+set yrange [2:70]
 set xtics (0.03, 0.04, 0.05, 0.06, 0.07)
 set grid
 set key top left
@@ -22,7 +22,11 @@ plot f using (sel(45, 0.2, $2)):4 with points pt 7 ps 1.4 lc rgb "#1f77b4" title
      f using (sel(60, 0.2, $2)):4 with points pt 9 ps 1.4 lc rgb "#2ca02c" title "60 deg, w 0.2 m", \
      f using (sel(60, 0.2, $2)):5 with lines lw 1.5 lc rgb "#2ca02c" dt 2 notitle, \
      f using (sel(60, 0.3, $2)):4 with points pt 11 ps 1.4 lc rgb "#9467bd" title "60 deg, w 0.3 m", \
-     f using (sel(60, 0.3, $2)):5 with lines lw 1.5 lc rgb "#9467bd" dt 2 notitle,
+     f using (sel(60, 0.3, $2)):5 with lines lw 1.5 lc rgb "#9467bd" dt 2 notitle, \
+     f using (sel(45, 0.2, $2)):8 with points pt 6 ps 1.4 lc rgb "#1f77b4" title "F0 (open), same colours", \
+     f using (sel(45, 0.3, $2)):8 with points pt 4 ps 1.4 lc rgb "#d62728" notitle, \
+     f using (sel(60, 0.2, $2)):8 with points pt 8 ps 1.4 lc rgb "#2ca02c" notitle, \
+     f using (sel(60, 0.3, $2)):8 with points pt 10 ps 1.4 lc rgb "#9467bd" notitle
 unset logscale
 set title "Horizontal force along the push, rake 45 deg, w 0.3 m (FEE: dashed)" noenhanced
 set xlabel "blade travel (m)"

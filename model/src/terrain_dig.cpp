@@ -222,14 +222,47 @@ void Terrain::cut(const Shovel& s) {
   // The lead (terrain.h, "the cut"): the footprint reaches one cell plus one particle diameter beyond the box
   // on the side of the cutting edge, so the rigid wall of uncut ground stands clear of the edge.
   Real loX = s.loX, hiX = s.hiX, loY = s.loY, hiY = s.hiY;
-  {
-    const Real lead = std::max(dx_, dy_) + 2 * particleAttributes_.getParticleRadius();
-    const Real ex = s.tipL.x() - 0.5 * (s.loX + s.hiX), ey = s.tipL.y() - 0.5 * (s.loY + s.hiY);
-    const Real len = std::hypot(ex, ey);
-    if (len > 0) {
-      (ex > 0 ? hiX : loX) += lead * ex / len;
-      (ey > 0 ? hiY : loY) += lead * ey / len;
+  const Real lead = std::max(dx_, dy_) + 2 * particleAttributes_.getParticleRadius();
+  const Real exR = s.tipL.x() - 0.5 * (s.loX + s.hiX), eyR = s.tipL.y() - 0.5 * (s.loY + s.hiY);
+  const Real len = std::hypot(exR, eyR);
+  Real ex = 0, ey = 0;  // unit horizontal direction to the edge
+  // The failure wedge (terrain.h, "The failure wedge"): a plain shovel (not a deformer) with a horizontal
+  // direction to its edge also cuts the soil above the FEE failure plane, which rises at beta* from the lead's
+  // front up to the height of the shovel's box top; that soil becomes particles in front of the shovel.
+  Real tanBeta = 0, reach = 0;
+  const bool wedge = failureWedge_ && len > 0 && !isGeometryDeformer(*s.geometry);
+  if (len > 0) {
+    ex = exR / len, ey = eyR / len;
+    if (wedge) {
+      const size_t ti = size_t(std::clamp<long long>(std::llround((s.tipL.x() - x0) / dx_), 0, (long long)nx_ - 1));
+      const size_t tj = size_t(std::clamp<long long>(std::llround((s.tipL.y() - y0) / dy_), 0, (long long)ny_ - 1));
+      const TerrainDataInterface& di0 = *data_;
+      MaterialRef soil = di0.entries_[di0.index_[tj * nx_ + ti]].material;
+      if (!soil) soil = defaultMaterial();
+      MaterialRef blade = s.geometry->getMaterial();
+      Simulation& sim = *getSimulation();
+      if (!blade) blade = sim.getMaterialManager().getDefaultMaterial();
+      SurfaceParameters bs;
+      const FrictionModel* fm = nullptr;
+      sim.getMaterialManager().resolve(blade.get(), soil.get(), bs, &fm);
+      const Real muS = soil->getFrictionCoefficient(), muB = bs.getFrictionCoefficient();
+      const Real phi = std::isfinite(muS) ? std::atan(muS) : 0.5 * kPi - 1e-3;
+      const Real delta = std::isfinite(muB) ? std::atan(muB) : 0.5 * kPi - 1e-3;
+      // Rake: the cutting plane's angle from the field's horizontal (up is its normal).
+      const Real rake = std::acos(std::clamp<Real>(s.upL.z(), -1, 1));
+      const Real beta = failureWedgeAngle(rake, std::min<Real>(phi, 0.5 * kPi - 1e-3), std::min<Real>(delta, 0.5 * kPi - 1e-3));
+      tanBeta = std::tan(beta);
+      Real boxHighL = -std::numeric_limits<Real>::infinity();
+      const Transform& T = geometry_->getTransform();
+      for (int k = 0; k < 8; ++k) {
+        const Vec3 c((k & 1) ? s.box.hi.x() : s.box.lo.x(), (k & 2) ? s.box.hi.y() : s.box.lo.y(),
+                     (k & 4) ? s.box.hi.z() : s.box.lo.z());
+        boxHighL = std::max(boxHighL, T.applyInverse(c).z());
+      }
+      reach = std::max<Real>(0, boxHighL - s.boxLowL) / tanBeta;
     }
+    (exR > 0 ? hiX : loX) += (lead + reach) * exR / len;  // reach = 0: the lead alone, as without the wedge
+    (eyR > 0 ? hiY : loY) += (lead + reach) * eyR / len;
   }
   const long long i0 = std::max<long long>(0, clampIndex((loX - x0) / dx_, nx_) + 1);
   const long long i1 = std::min<long long>((long long)nx_ - 1, clampIndex((hiX - x0) / dx_, nx_));
@@ -244,7 +277,11 @@ void Terrain::cut(const Shovel& s) {
       if (lockedBorders_ && isBorderVertex(size_t(i), size_t(j))) continue;
       const Real x = x0 + Real(i) * dx_, y = y0 + Real(j) * dy_;
       const Real zPlane = s.tipL.z() - (n.x() * (x - s.tipL.x()) + n.y() * (y - s.tipL.y())) / n.z();
-      const Real floor = std::max(zPlane, s.boxLowL);
+      Real floor = std::max(zPlane, s.boxLowL);
+      if (wedge) {
+        const Real xi = (x - s.tipL.x()) * ex + (y - s.tipL.y()) * ey;  // ahead of the edge, horizontally
+        if (xi > lead) floor = std::max(floor, s.boxLowL + (xi - lead) * tanBeta);
+      }
       const Real h = heightField_->getHeight(size_t(i), size_t(j));
       if (!(h > floor)) continue;
       const Real dz = h - floor;
@@ -263,7 +300,33 @@ void Terrain::cut(const Shovel& s) {
         di.multiplier_[v] = TerrainDataInterface::multiplier(di.compression_[v], d, M);
       }
     }
-  createParticles(s, size_t(i0), size_t(i1), size_t(j0), size_t(j1));
+  const Real rect[4] = {loX, hiX, loY, hiY};
+  createParticles(s, size_t(i0), size_t(i1), size_t(j0), size_t(j1), wedge ? rect : nullptr);
+}
+
+Real Terrain::failureWedgeAngle(Real rake, Real phi, Real delta) {
+  constexpr const char* where = "Terrain::failureWedgeAngle";
+  if (!std::isfinite(rake)) detail::throwInvalid(where, "rake", rake, "must be finite");
+  if (!(phi >= 0 && phi < 0.5 * kPi)) detail::throwInvalid(where, "phi", phi, "must be in [0, pi/2)");
+  if (!(delta >= 0 && delta < 0.5 * kPi)) detail::throwInvalid(where, "delta", delta, "must be in [0, pi/2)");
+  const Real alpha = std::clamp<Real>(rake, 1e-3, 0.5 * kPi);
+  // N_gamma(beta) (+inf where D <= 0); unimodal on (0, pi/2 - phi).
+  auto n = [&](Real beta) {
+    const Real D = std::cos(alpha + delta) + std::sin(alpha + delta) / std::tan(beta + phi);
+    if (!(D > 0)) return std::numeric_limits<Real>::infinity();
+    return (1 / std::tan(alpha) + 1 / std::tan(beta)) / (2 * D);
+  };
+  Real a = 1e-6, b = 0.5 * kPi - phi - 1e-6;
+  const Real g = 0.5 * (std::sqrt(5.0) - 1);
+  Real x1 = b - g * (b - a), x2 = a + g * (b - a), f1 = n(x1), f2 = n(x2);
+  while (b - a > 1e-9) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a), f1 = n(x1);
+    } else {
+      a = x1, x1 = x2, f1 = f2, x2 = a + g * (b - a), f2 = n(x2);
+    }
+  }
+  return 0.5 * (a + b);
 }
 
 MaterialRef Terrain::particleMaterial(size_t v) {
@@ -306,7 +369,7 @@ struct CellHash {
 };
 }  // namespace
 
-void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, size_t j1) {
+void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, size_t j1, const Real* siteRect) {
   const Real V = getParticleVolume();
   bool any = false;
   for (size_t j = j0; j <= j1 && !any; ++j)
@@ -334,6 +397,14 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
   for (const auto& [id, vol] : particles_)
     if (gbs.isValid(id)) {
       const Vec3 pw = gbs.getPosition(id);
+      if (siteRect) {
+        const Vec3 p = T.applyInverse(pw);
+        if (p.x() < siteRect[0] - reachXY || p.x() > siteRect[1] + reachXY || p.y() < siteRect[2] - reachXY ||
+            p.y() > siteRect[3] + reachXY)
+          continue;
+        grid[keyOf(p)].push_back(p);
+        continue;
+      }
       if (pw.x() < s.box.lo.x() - reachXY || pw.x() > s.box.hi.x() + reachXY || pw.y() < s.box.lo.y() - reachXY ||
           pw.y() > s.box.hi.y() + reachXY)
         continue;
@@ -389,10 +460,15 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
                                           std::max(heightField_->getHeight(ci, cj + 1), heightField_->getHeight(ci + 1, cj + 1)));
                 if (!(p.z() >= top + r)) continue;
               }
-              const Vec3 pw = T.apply(p);
-              if (!(pw.x() >= s.box.lo.x() && pw.x() <= s.box.hi.x() && pw.y() >= s.box.lo.y() &&
-                    pw.y() <= s.box.hi.y()))
-                continue;
+              if (siteRect) {
+                if (!(p.x() >= siteRect[0] && p.x() <= siteRect[1] && p.y() >= siteRect[2] && p.y() <= siteRect[3]))
+                  continue;
+              } else {
+                const Vec3 pw = T.apply(p);
+                if (!(pw.x() >= s.box.lo.x() && pw.x() <= s.box.hi.x() && pw.y() >= s.box.lo.y() &&
+                      pw.y() <= s.box.hi.y()))
+                  continue;
+              }
               sites.push_back({above, p});
             }
       std::sort(sites.begin(), sites.end(), [](const Site& l, const Site& rr) {

@@ -280,13 +280,34 @@
 // blade pushes wedge between the blade and that wall and jam, loading the blade with forces that grew with the
 // solver's iterations and with smaller time steps (a 1 cm blade in the FEE study gave 33, 50 and 88 N for 30 and
 // 60 iterations and half the step, docs/terrain.md); with the wall a particle diameter clear of the edge they rise instead
-// (10.3, 10.8, 14.1 N), as loosened soil in front of a real blade does. Particles are made over the box only (below):
+// (10.3, 10.8, 14.1 N), as loosened soil in front of a real blade does. Particles are made over the box only (below;
+// with the failure wedge on, over the whole cut):
 // the lead's volume stays pending until the box passes over it (where a shovel stops, the trench runs a lead
 // further than the box went and that strip stays pending). Each footprint
 // vertex whose height lies above the cutting plane - and above the box's lowest point: the shovel never cuts
 // deeper than it reaches - is lowered to it; the volume (vertex area x dz) moves heightField -> pending at that
 // vertex, and c rises by the compression rule above (a deformable vertex gets harder as it is dug deeper).
 // Locked border vertices are never cut.
+//
+// The failure wedge (setShovelFailureWedge, default off; issue 16's FEE study, docs/terrain.md). With it on, a
+// plain shovel's cut (not a deformer's: a deformer pushes the soil ahead as compression and a berm) also takes
+// the soil in front of the lead that lies above the failure plane of the fundamental earthmoving equation: the
+// plane rises at beta* (failureWedgeAngle: the FEE's minimising angle for the shovel's rake - the cutting
+// plane's angle from the horizontal - the soil's phi = atan(friction of the material of the vertex nearest the
+// tip) and delta = atan(friction of the shovel's material with that material)) from the box's lowest point at the
+// lead's front, in the horizontal direction from the box's centre to the tip, up to the height of the box's top;
+// across it, the footprint's (axis-aligned) extent as for the lead. The soil it takes goes heightField -> pending
+// as any cut, and particles are made over the whole cut (box, lead and wedge: sites lie over that rectangle, not
+// only over the box). Why: the manual cuts "the volume above the cutting surface inside the footprint", and
+// with a rigid height field ahead of the edge nothing fails in front of a blade: a blade then pushes only what it
+// has already cut, a force that grows with travel and linearly with depth (the FEE's surcharge term), and the
+// FEE's gamma d^2 w N_gamma - the weight and shear of the wedge - is missing (docs/terrain.md measured it at 0.02-
+// 0.5 of the FEE). Taking the wedge as particles makes the soil the FEE fails a body of particles the shovel must
+// lift up the failure plane (the height field, soil friction) - the FEE's mechanism - with its volume ~ d^2 w.
+// The toe starts at the lead's front, not at the edge, so the floor is continuous (a step there would be the
+// wall the lead removes). Why off by default: the read-outs and tests of buckets assume particles are made over
+// the box (the fill is "the particles the cut made"), and a bucket's rake (its up nearly vertical) gives a long,
+// shallow wedge that turns ground the bucket never reaches into particles.
 //
 // Particles (25.1.2.7-25.1.2.9). Pending volume becomes particles on a face-centred cubic lattice fixed in the
 // field's frame (anchored at vertex (0, 0), z = 0), nearest neighbours at d = 2r - r(sqrt2 - 1) = r(3 - sqrt2),
@@ -624,6 +645,16 @@ class Terrain : public Model {
   Real getParticleVolume() const;
   /// Nearest-neighbour distance of the particle lattice, r (3 - sqrt2).
   Real getParticleLatticeDistance() const;
+  // --- the failure wedge of a plain shovel's cut (issue 16, FEE; file comment "The failure wedge") ---
+  /// The fundamental earthmoving equation's failure-plane angle beta* (rad, from the horizontal) of a blade of
+  /// rake `rake` (rad from the horizontal, clamped to [1e-3, pi/2]) in cohesionless soil of friction angle `phi`
+  /// with soil-blade friction angle `delta`: the beta in (0, pi/2 - phi) that minimises N_gamma =
+  /// (cot rake + cot beta) / (2 (cos(rake + delta) + sin(rake + delta) cot(beta + phi))); golden-section search
+  /// to 1e-9 rad. Bad input (non-finite, phi outside [0, pi/2), delta outside [0, pi/2)) throws.
+  static Real failureWedgeAngle(Real rake, Real phi, Real delta);
+  /// Whether a plain shovel's cut also takes its failure wedge (file comment "The failure wedge"); default false.
+  void setShovelFailureWedge(bool enable) { failureWedge_ = enable; }
+  bool getShovelFailureWedge() const { return failureWedge_; }
   /// Pending volume at vertex (x, y), m^3.
   Real getPendingVolume(size_t x, size_t y) const { return pending_[y * nx_ + x]; }
   /// Ids (GranularBodySystem) of the live particles this terrain made.
@@ -677,7 +708,10 @@ class Terrain : public Model {
   void findShovels(std::vector<Shovel>& out);
   void mergeParticles(const std::vector<Shovel>& shovels);
   void cut(const Shovel& shovel);
-  void createParticles(const Shovel& shovel, size_t i0, size_t i1, size_t j0, size_t j1);
+  /// siteRect (field frame: loX, hiX, loY, hiY) replaces the shovel's box as the region sites may lie over when
+  /// non-null (a plain shovel's lead and failure wedge).
+  void createParticles(const Shovel& shovel, size_t i0, size_t i1, size_t j0, size_t j1,
+                       const Real* siteRect = nullptr);
   MaterialRef particleMaterial(size_t v);
   // --- particle contact materials (terrain_particle_materials.cpp) ---
   struct ParticleMaterialCache;
@@ -764,6 +798,7 @@ class Terrain : public Model {
   // Digging.
   Real minDigAngle_ = 3.14159265358979323846 / 10;
   Real mergeVelocity_ = 0.1;
+  bool failureWedge_ = false;  // setShovelFailureWedge (issue 16, FEE)
   TerrainParticleAttributes particleAttributes_{*this};
   std::vector<Real> pending_;                              ///< per vertex, m^3
   std::vector<std::pair<size_t, Real>> particles_;        ///< live terrain particles: id, carried volume
