@@ -27,7 +27,7 @@ for arg in "$@"; do
     --with-plot) packages+=(gnuplot-nox) ;;
     --with-bullet) packages+=(libbullet-dev) ;;
     --check) check_only=1 ;;
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) awk 'NR > 1 && !/^#/ {exit} NR > 1 && !/SPDX-License-Identifier|^# Copyright \(c\)/' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "install-deps.sh: unknown option '$arg' (try --help)" >&2; exit 2 ;;
   esac
 done

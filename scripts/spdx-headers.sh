@@ -25,7 +25,7 @@ while [[ $# -gt 0 ]]; do
   case "$1" in
     --check) check=1 ;;
     --root) root="$(cd "$2" && pwd)"; shift ;;
-    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) awk 'NR > 1 && !/^#/ {exit} NR > 1 && !/SPDX-License-Identifier|^# Copyright \(c\)/' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "spdx-headers.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift

@@ -2,7 +2,7 @@
 """test_docs_snippets: every C++ code block the docs show is compiled code, and the compiled snippets run.
 
 The snippets are the files examples/snippets/*.cpp; test/CMakeLists.txt builds each as snippet_<name>. A file's
-shown text is either the whole file or, when the file has them, each region between a line `// [doc]` and a
+shown text is either the whole file (without its leading SPDX licence lines) or, when the file has them, each region between a line `// [doc]` and a
 line `// [/doc]` (dedented by the region's common indentation), so a page may show a fragment while the file
 gives it the declarations around it.
 
@@ -36,8 +36,17 @@ def dedent(lines):
     return "\n".join(l[cut:] if l.strip() else "" for l in lines).strip("\n")
 
 
+def without_licence_header(text):
+    """The file's text without its leading SPDX licence lines (scripts/spdx-headers.sh), which pages omit."""
+    lines = text.split("\n")
+    while lines and (lines[0].startswith("// SPDX-License-Identifier:") or lines[0].startswith("// Copyright (c)")):
+        lines.pop(0)
+    return "\n".join(lines)
+
+
 def shown_texts(path):
-    lines = path.read_text().split("\n")
+    text = without_licence_header(path.read_text())
+    lines = text.split("\n")
     regions, current = [], None
     for line in lines:
         if line.strip() == "// [doc]":
@@ -52,7 +61,7 @@ def shown_texts(path):
             current.append(line)
     if current is not None:
         errors.append(f"{path}: '// [doc]' without '// [/doc]'")
-    return regions if regions else [path.read_text().strip("\n")]
+    return regions if regions else [text.strip("\n")]
 
 
 snippet_dir = source / "examples" / "snippets"
