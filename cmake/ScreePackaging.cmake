@@ -58,15 +58,15 @@ set(CPACK_DEBIAN_PACKAGE_RELEASE "")
 set(CPACK_DEBIAN_PACKAGE_SECTION libdevel)
 set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 set(CPACK_DEBIAN_PACKAGE_MAINTAINER ${SCREE_PACKAGE_MAINTAINER})
+# The Description's first line is CPACK_PACKAGE_DESCRIPTION_SUMMARY; this is the extended text (CPack indents it).
 set(CPACK_DEBIAN_PACKAGE_DESCRIPTION
-    "C++20 physics SDK for earthmoving, off-road vehicles and grasping
- Scree simulates rigid bodies with joints and contacts (projected Gauss-Seidel
- and a sparse direct solver), granular particles, and a model layer after the
- agxModel chapter of the AGX Dynamics manual: a deformable terrain that can be
- dug, two-body tire models, granular field post-processing and suction
- grippers. This package holds the static libraries, headers and CMake package
- (find_package(Scree)), and the scree program that runs, records and replays
- the built-in scenes.")
+    "Scree simulates rigid bodies with joints and contacts (projected Gauss-Seidel
+and a sparse direct solver), granular particles, and a model layer after the
+agxModel chapter of the AGX Dynamics manual: a deformable terrain that can be
+dug, two-body tire models, granular field post-processing and suction
+grippers. This package holds the static libraries, headers and CMake package
+(find_package(Scree)), and the scree program that runs, records and replays
+the built-in scenes.")
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "${_scree_deb_depends}")
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "cmake (>= 3.25), g++ (>= 4:12)")
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)  # dpkg-shlibdeps (dpkg-dev) on the scree program

@@ -40,7 +40,7 @@ debs=("$tmp"/deb/libscree-dev_*.deb)
 [[ ${#debs[@]} -eq 1 && -f "${debs[0]}" ]] || fail "expected one libscree-dev_*.deb in $tmp/deb"
 deb="${debs[0]}"
 ls -l "$deb"
-dpkg-deb -I "$deb" | sed -n '/Package:/,$p'
+dpkg-deb -f "$deb" | sed 's/^/  /'
 field() { dpkg-deb -f "$deb" "$1"; }
 [[ "$(field Package)" == libscree-dev ]] || fail "Package is '$(field Package)'"
 [[ "$(field Version)" == "$cmake_version" ]] || fail "Version '$(field Version)' != CMake package version '$cmake_version'"
@@ -117,6 +117,9 @@ for p in $paths; do
   owners=$(dpkg -S "$p" 2>/dev/null | sed 's/: .*//' | tr ',' '\n' | sed 's/:.*//; s/ //g' || true)
   if [[ -z "$owners" && "$p" == /usr/* ]]; then  # merged /usr: some packages register /lib/... paths
     owners=$(dpkg -S "${p#/usr}" 2>/dev/null | sed 's/: .*//' | tr ',' '\n' | sed 's/:.*//; s/ //g' || true)
+  fi
+  if [[ -z "$owners" && -e "$p" ]]; then  # an alternatives symlink (/usr/bin/c++): the file it resolves to
+    owners=$(dpkg -S "$(readlink -f "$p")" 2>/dev/null | sed 's/: .*//' | tr ',' '\n' | sed 's/:.*//; s/ //g' || true)
   fi
   [[ -n "$owners" ]] || fail "$p (used by the consumer's build) belongs to no Debian package"
   ok=0

@@ -37,6 +37,6 @@ TEST_CASE("the CMake package version (ScreeConfigVersion.cmake) equals getVersio
   text << in.rdbuf();
   std::smatch m;
   const std::string s = text.str();
-  REQUIRE(std::regex_search(s, m, std::regex(R"(set\(PACKAGE_VERSION "([^"]*)"\))")));
+  REQUIRE(std::regex_search(s, m, std::regex(R"re(set\(PACKAGE_VERSION "([^"]*)"\))re")));
   CHECK(m[1].str() == scree::getVersionString());
 }
