@@ -37,6 +37,10 @@ foreach(_dir core/include collide/include solver/include model/include model/io/
           FILES_MATCHING PATTERN "*.h" PATTERN "*.hpp")
 endforeach()
 
+# The generated version header (core/CMakeLists.txt, cmake/version_number.h.in).
+install(FILES ${PROJECT_BINARY_DIR}/generated/include/scree/version_number.h
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/scree)
+
 # What the package config must re-find for consumers.
 get_target_property(_scree_collide_type scree_collide TYPE)
 if(_scree_collide_type STREQUAL "STATIC_LIBRARY")
@@ -89,6 +93,9 @@ configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/ScreeConfig.cmake.in
 foreach(_f IN LISTS _scree_find_modules)
   configure_file(${_f} ${PROJECT_BINARY_DIR} COPYONLY)
 endforeach()
+
+# Licences, notices and the Debian package (CPack): cmake/ScreePackaging.cmake.
+include(${PROJECT_SOURCE_DIR}/cmake/ScreePackaging.cmake)
 
 unset(_scree_modules)
 unset(_scree_collide_type)

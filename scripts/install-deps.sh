@@ -16,7 +16,8 @@ set -euo pipefail
 
 packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libccd-dev libpng-dev zlib1g-dev doctest-dev libbenchmark-dev
           libcli11-dev chromium python3-meshio python3-pil
-          python3-vtk9)  # VTK's own XML readers validate the ParaView export in test_unit_vtk_export
+          python3-vtk9  # VTK's own XML readers validate the ParaView export in test_unit_vtk_export
+          dpkg-dev file)  # CPack's Debian package: dpkg-shlibdeps (dpkg-dev) on the scree program, which uses file
 # npm (three.js for the replay page, fetched from the npm registry at build time): Debian's package only when no
 # npm is on the PATH already (a machine with Node.js from elsewhere would conflict with Debian's npm).
 command -v npm >/dev/null 2>&1 || packages+=(npm)
@@ -26,7 +27,7 @@ for arg in "$@"; do
     --with-plot) packages+=(gnuplot-nox) ;;
     --with-bullet) packages+=(libbullet-dev) ;;
     --check) check_only=1 ;;
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) awk 'NR > 1 && !/^#/ {exit} NR > 1 && !/SPDX-License-Identifier|^# Copyright \(c\)/' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "install-deps.sh: unknown option '$arg' (try --help)" >&2; exit 2 ;;
   esac
 done

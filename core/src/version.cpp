@@ -2,10 +2,10 @@
 
 namespace scree {
 
-const char* getVersionString() { return "0.1.0"; }
+const char* getVersionString() { return SCREE_VERSION_STRING; }
 
 const char* getConfigurationString() {
-  return "Scree 0.1.0 ("
+  return "Scree " SCREE_VERSION_STRING " ("
 #ifdef NDEBUG
          "optimised"
 #else

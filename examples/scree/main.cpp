@@ -314,6 +314,8 @@ int runScene(const RunOptions& o) {
 int main(int argc, char** argv) {
   CLI::App app{"scree: run Scree's built-in scenes"};
   app.require_subcommand(1);
+  // scree --version: the library's configuration string, "Scree 0.1.0 (optimised; ...)" (scree/version.h).
+  app.set_version_flag("--version", std::string(getConfigurationString()));
   CLI::App* list = app.add_subcommand("list", "print the built-in scenes, one line each");
   CLI::App* runCmd = app.add_subcommand("run", "run a scene and print a summary");
   RunOptions o;
@@ -337,6 +339,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "scree: error: %s\n", e.what());
