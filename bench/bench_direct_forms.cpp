@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The two matrix forms of the DIRECT solver (solver/include/scree/solver/direct.h) side by side: the Schur
 // complement A = G M^-1 G^T + E (CHOLMOD LL^T) and the quasi-definite KKT [M -G^T; -G -E] (CHOLMOD LDL^T), on
 // chains, stacks and particle lumps. One benchmark iteration = one Simulation::stepForward() (the whole step, as

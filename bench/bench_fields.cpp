@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // GranularFieldPostProcessor throughput: N particles (uniform random in a 1 m cube, radii 4–7 mm) into a 64^3
 // voxel grid (voxel 15.6 mm >= the largest diameter). Args: {particles, threads, all}: all = 0 computes the
 // manual's fields (mass, momentum, velocity), all = 1 adds solid volume fraction and kinetic stress. Counters: particles per second and the relative mass

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Particle benchmarks (GranularBodySystem):
 //   spheres10k_jitter as particles (docs/scenes.md: 10,000 spheres r 0.05, dt 1/100, 10 iterations, 300 steps),
 //     on 1 and 2 threads: median and mean ms/step over the whole run, and the scene's metrics at the end

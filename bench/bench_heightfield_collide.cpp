@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Narrowphase cost of shapes against a HeightField (collide/src/heightfield_collide.cpp): ns per call of
 // collideGeometries for one shape-height-field pair, one thread. Each case cycles through 64 poses (a wheel rolling
 // along x over the cells, the axis turned by the case's angle relative to the grid) so the cost is averaged over

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Narrowphase cost per pair type: ns per collideGeometries call (one thread), for resting configurations — the
 // upper shape overlaps the lower by 1 mm and is tilted by 0.01 rad so that no case is exactly symmetric. The
 // reported time is ns per pair (one call per iteration); the counter "points" is the number of contact points the call returns (the manifold's size).

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // One fixture per reference scene of docs/scenes.md. See scene_fixture.h for the timing pattern (one iteration =
 // one step, scenes rebuilt untimed at the end of each defined run) and the metric counters (one untimed
 // complete run after the timed loop).

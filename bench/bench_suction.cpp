@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Suction gripper cost: N cups (1..64) on one static holder, each cup's lip resting sealed on its own 1 kg box
 // that stands on the ground (10 % vacuum, lip radius 2.5 cm: 19.7 N of vacuum per cup, more than the box's
 // 9.81 N weight, so each box is pulled up against its lip and stays there). The baseline is the same bodies, joints and cup

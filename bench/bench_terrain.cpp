@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Cost of the Terrain (issue 15): the four-wheeled vehicle on TwoBodyTireModel tires (bench/scenes/vehicle.h)
 // driving at 2 m/s over a 257 x 257 field (0.1 m cells), once on a deformable Terrain and once on a plain
 // HeightField with the same heights, materials and contact stiffness; and idle: the vehicle on its plane while a

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Cost of terrain avalanches (issue 17; terrain.h "Dynamic height field: avalanches and the angle of repose").
 //
 // BM_avalanche_local/n: an n x n terrain (0.1 m cells, 0.5 m of soil, friction 0.5: repose atan(0.5)) with the

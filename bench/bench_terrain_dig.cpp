@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Cost of digging (issue 16): the trench scene of bench/scenes/terrain_dig.h (kinematic 0.6 m wide bucket digs an
 // 8 cm deep, 0.7 m long trench in 0.05 m cells, 15 mm particles, 6,700 live at the peak; lifts, dumps, 4 s of
 // settling) at h = 1/60 s, 10 iterations, on 1 and 2 threads, and on 1 thread with the bucket of registered

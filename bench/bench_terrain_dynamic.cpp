@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Cost of the dynamic height field with a deformer (issue 17; terrain.h "Dynamic height field: deformers" and
 // "... avalanches and the angle of repose"; the scene: bench/scenes/terrain_dozer.h).
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Cost of the TwoBodyTireModel (issue 6): one step of the four-wheeled vehicle (bench/scenes/vehicle.h)
 // driving at 2 m/s over flat ground and a bump, with tire models (rim + tire per wheel) and with rigid wheels
 // (tire hinged to the chassis, no rim, no tire model). Same time step (1/400 s) and PGS iterations (20).

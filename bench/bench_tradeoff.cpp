@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The speed-accuracy trade (issue 4): every reference scene of the sweep is run for a fixed simulated time under
 // solve type x iterations x time step, recording the median wall time of a step and the error that matters for
 // the scene. scripts/speed_accuracy.py runs this with --benchmark_format=json and turns the output into

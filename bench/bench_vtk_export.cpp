@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // VtkExporter::writeFrame cost (scree/io/vtk_export.h). BM_VtkParticles/N: N particles (random in a 1 m cube)
 // and the docs/scenes.md ground box; BM_VtkFull adds a 129 x 129 terrain and a 16^3 granular field grid
 // (velocity, mass, momentum, kinetic stress) to 10,000 particles. Counters: bytes per frame. Files go to a

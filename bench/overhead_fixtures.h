@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The two overhead fixtures, shared by bench_overhead (run in CI) and bench_scenes.
 #pragma once
 

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Google Benchmark fixture base for the reference scenes (bench/scenes, docs/scenes.md).
 //
 // Timing: one benchmark iteration = one Simulation::stepForward(). Every timed step belongs to a run of the

@@ -1,3 +1,5 @@
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 # FindCCD: libccd (Debian: libccd-dev ships a pkg-config file, no CMake config). Defines CCD::CCD.
 find_package(PkgConfig QUIET)
 if(PKG_CONFIG_FOUND)

@@ -1,3 +1,5 @@
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 # FindCHOLMOD: SuiteSparse CHOLMOD (Debian 12's libsuitesparse-dev 5.12 ships no CMake config).
 # Defines SuiteSparse::CHOLMOD.
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse)

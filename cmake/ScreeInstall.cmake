@@ -1,3 +1,5 @@
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 # Install rules and the exported CMake package (included OPTIONAL at the end of the root CMakeLists.txt).
 #
 # Consumers write

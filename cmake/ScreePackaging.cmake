@@ -1,3 +1,5 @@
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 # Licences, notices and the Debian package libscree-dev (CPack), included by cmake/ScreeInstall.cmake.
 #
 #   cpack --config build/CPackConfig.cmake -B <dir>     ->  <dir>/libscree-dev_<version>_<arch>.deb

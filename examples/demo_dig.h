@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Part of scree_demo: digging (issue 16). The trench scene of bench/scenes/terrain_dig.h in its lighter demo form
 // (TerrainDigParams::demoParams: 25 mm particles, a 0.4 m trench): a kinematic bucket - blade (the shovel), back
 // plate and sides - is lowered 8 cm into a Terrain, dragged forward (the cut soil becomes particles in the

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Part of scree_demo: a dozer blade (issue 17). The scene of bench/scenes/terrain_dozer.h on a small field (65 x 65
 // vertices, 6.4 m): a 2 m blade (a DynamicHeightFieldDeformer geometry) cuts 10 cm into the soil and pushes it at
 // 0.5 m/s for 3 s; the soil it overlaps is moved ahead of it into a berm, whose moved vertices avalanche toward

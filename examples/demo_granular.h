@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Granular part of scree_demo: a nozzle pours particles (r = 3 cm, with rolling resistance) onto the ground at
 // (-5, -5) for the first seconds, forming a conical pile. Written as a step listener so the demo only adds
 // it to the simulation: it creates particles in preCollide, at run time, through GranularBodySystem.

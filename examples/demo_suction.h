@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Suction gripper pick-and-place for the demo (issue 8): a carriage slides along x on a prismatic joint to the
 // world, a holder slides along z on a prismatic joint to the carriage and carries one suction cup (lip radius
 // 6 cm, 16 seal sensors, the holder itself as the cup body) on a vacuum system at 20 % vacuum (226 N available

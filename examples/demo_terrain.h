@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Part of scree_demo: the vehicle of demo_vehicle.h (TwoBodyTireModel tires) on soft ground - a deformable
 // Terrain (0.1 m cells, deformability 1, the default compression parameters fitted to a dry sand; docs/terrain.md)
 // - driving forward, back and forward again over the same 2 m of ground. Prints, per pass, how much deeper the

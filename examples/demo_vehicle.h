@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Part of scree_demo: a four-wheeled vehicle on TwoBodyTireModel tires (issue 6) driving at 2 m/s over flat
 // ground and an 8 cm bump. Chassis box, hinge-motor axles, rims and tires as built by bench/scenes/vehicle.cpp
 // (read it to build your own: a rim body per wheel hinged to the chassis with a Motor1D, a Cylinder tire body

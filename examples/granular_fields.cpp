@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // granular_fields: a block of 512 sand particles falls onto the ground; a GranularFieldPostProcessor computes the
 // mass, velocity and packing fields every 15 steps and prints the vertical profile, then writes
 // granular_fields.vti (open it in ParaView) and a CSV slice through the middle.

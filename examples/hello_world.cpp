@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // hello_world: a box dropped on the ground, printing its height.
 #include <cstdio>
 

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // scree_demo: the demo the README's first command runs. A built-in scene showing what the engine does today:
 // a 10-box tower, a 6-row pyramid, a box sliding to rest on friction, a bouncing ball (restitution), a heavy
 // box on a light one (1000:1), and a mixed pile of spheres, capsules, cylinders and convex hulls dropped on the

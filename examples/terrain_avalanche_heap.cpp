@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Writes the heap a tall column of soil relaxes into with Terrain::avalancheAll, to look at it against the angle
 // of repose: a 65 x 65 terrain (0.1 m cells) with 4 m^3 of soil on its centre vertex, relaxed twice - once with
 // the material's angle of repose unset (theta = atan(mu) = atan(0.5) = 26.6 deg) and once set to 35 deg. For each

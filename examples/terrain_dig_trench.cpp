@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // terrain_dig_trench: the trench scene of bench/scenes/terrain_dig.h - a kinematic bucket (blade, back plate and
 // sides) digs an 8 cm deep, 0.7 m long trench in a Terrain, lifts the soil, dumps it by turning its tip down, and
 // the heap merges back into the height field. Prints per phase the particles created and merged, the live

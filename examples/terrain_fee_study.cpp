@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // terrain_fee_study: the digging force of a flat blade pushed through cohesionless Terrain soil (the cut soil
 // becomes particles that heap in front of the blade) against the fundamental earthmoving equation, for three
 // depths, two widths and two rake angles (bench/scenes/terrain_fee.h; docs/terrain.md, "Digging force against the

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Plate-sinkage study for docs/terrain.md: settled plastic sinkage of a Terrain under a uniform plate pressure
 // (10-100 kPa) for three deformabilities, against the law's closed form z* = D ln(p/p0) / ((d+1) ln M) and
 // against Bekker's p = (k_c/b + k_phi) z^n for a dry sand (J.Y. Wong, Theory of Ground Vehicles, Table 2.3, LLL

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Writes the ruts a vehicle leaves on soft ground as a depth map, to look at them rather than read a number:
 // the vehicle of the demo (tire models) drives 4 s forward over a deformable Terrain (0.1 m cells,
 // deformability 1), then the depth of every vertex below the original surface is written as "x y depth_mm"

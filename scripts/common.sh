@@ -1,3 +1,5 @@
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 # shellcheck shell=bash
 # Shared helpers for scripts/*.sh (sourced, not run).
 # Repository root, whatever the caller's working directory.

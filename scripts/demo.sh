@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 # Builds and runs the Scree demo (examples/scree_demo.cpp) and shows its recording in the replay page:
 #   1. installs missing Debian packages (scripts/install-deps.sh),
 #   2. configures build/ in Release,

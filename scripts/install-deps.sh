@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 # Installs the Debian 12 packages Scree's build needs, only those that are missing.
 #
 #   bash scripts/install-deps.sh [--with-plot] [--with-bullet] [--check]

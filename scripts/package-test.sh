@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 # The Debian package test: builds libscree-dev_<version>_<arch>.deb from a built tree with CPack, unpacks it into
 # a fresh root (dpkg -x: the system's dpkg database and /usr are not touched), and checks that
 #   1. its control fields are right: Package libscree-dev, Version = the CMake package version

@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 """Turns bench_tradeoff's JSON output into the generated part of docs/speed-accuracy.md and one PNG per scene.
 
     build/bench/bench_tradeoff --benchmark_format=json --benchmark_out=tradeoff.json

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 # Builds Scree and runs its test suites:
 #   1. installs missing Debian packages (scripts/install-deps.sh),
 #   2. configures build/ in Release with tests (benchmarks and examples are built too, so they keep compiling),

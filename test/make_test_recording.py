@@ -1,4 +1,6 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 """Writes a valid Scree recording (docs/recording.md) without the C++ writer, for the replay page's tests.
 
 It is an independent implementation of the format (zlib, struct and binascii.crc32 only), so the page's

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Minimal PNG files for the terrain's material-map tests, written byte by byte (independent of the reader under
 // test): zlib "stored" deflate blocks (no compression), CRC-32 and Adler-32 by their definitions (PNG spec,
 // RFC 1950/1951). Lets a test make any colour type and bit depth, and cut a file short.

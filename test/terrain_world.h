@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Helpers shared by the terrain tests: a flat terrain with a soil thickness (so the ledger total is a real volume
 // to be relative to), and a step loop that checks the volume ledger after every step.
 #pragma once

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Resting contact and restitution against closed forms.
 //
 // Contact model (solver/spook.h): a contact normal is a SPOOK row with compliance 1/E (E = Young's modulus of

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Full contact manifolds for every convex pair (issue 20; collide/src/convex_manifold.cpp, docs/design.md
 // "Contact manifolds for every convex pair"): cans, barrels and hulls resting on each other, a wheel rolling down
 // a ramp, capsules lying side by side.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // DIRECT solver (solver/include/scree/solver/direct.h, Simulation's hybrid solve) against closed-form values and
 // against converged PGS. In a build without SuiteSparse the cases that need the direct solver are skipped
 // (test_build.h) and the PGS half of the chain-report case still runs.

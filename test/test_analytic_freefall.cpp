@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Free fall and projectile motion against the integrator's discrete closed form.
 //
 // Scree integrates with semi-implicit (symplectic) Euler:

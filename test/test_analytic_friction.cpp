@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Coulomb friction against closed forms, on the reference scenes (bench/scenes: slide, incline_mu05/06).
 //
 // Discrete floor: with semi-implicit Euler at h = 1/60 the exact discrete solutions differ from the continuous

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Particles (GranularBodySystem) against closed-form values: free fall, resting overlap and force, free
 // collisions (momentum, energy, restitution), rolling resistance stopping distance, adhesion threshold,
 // fast particles against a thin wall, sensors; plus stable ids in a running simulation, destroy from a

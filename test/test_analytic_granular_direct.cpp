@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Particles (GranularBodySystem) through the DIRECT solver (the manual's DIRECT particle mode, see
 // solver/src/granular_stage.h): a glued lump that must stay rigid while falling and landing (one factorisation,
 // no pivot per falling step), against the same lump solved iteratively, and a particle column whose overlaps

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Bodies on a height field behave as on flat ground when the field is flat: same resting depth, same Coulomb
 // sliding distance (the discrete closed form of the slide scene), no sideways drift across triangle seams.
 #include <doctest/doctest.h>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // A cylinder against a height field with its true circle (collide/src/heightfield_collide.cpp): depths exact on
 // faces, edges and vertices (1e-9 r, the routine is closed form or converges to 1e-13 of an edge), a wheel rolling
 // down a height-field ramp at (2/3) g sin(alpha) like a sphere at (5/7) g sin(alpha), the static compliance sink,

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Joints and compliant constraints against closed-form dynamics (issue: joints, compliant constraints).
 #include <doctest/doctest.h>
 

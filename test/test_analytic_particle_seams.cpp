@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The particle seams of the step: particle contacts reach ContactEventListener::particleContacts with
 // per-point overrides (Young's modulus, disable, surface velocity) checked against closed forms; particles
 // honour collision groups; particles may be destroyed from a POST_STEP listener while it reads this step's

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Torque-free rotation: the Dzhanibekov (intermediate-axis) effect.
 //
 // A box with half extents (0.5, 0.2, 0.05) has principal moments I_x : I_y : I_z = 0.17 : 1.01 : 1.16 (x m/12),

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Exact ball–box intersection volume (model/src/sphere_box_volume): closed-form cases (whole ball, half
 // spaces, caps, quarters, octants), an independent reference (slice areas in closed form integrated over z by
 // adaptive Simpson), Monte Carlo, and the split pieces a voxelisation uses.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Stacks at rest: the analytic answer is "nothing moves". tower10 and pyramid20 (bench/scenes, docs/scenes.md)
 // must stand 10 s (600 steps at 1/60) with every box within 1 cm of its start; mass_ratio (1000 kg on 1 kg) must
 // hold.

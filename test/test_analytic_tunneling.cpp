@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Tunnelling: at 100 m/s and h = 1/60 a sphere of radius 0.1 m moves 1.67 m per step, 8x its diameter and 83x
 // the 2 cm wall's thickness. Discrete collision detection alone would miss the wall entirely; speculative
 // contacts (AABBs grown by the motion over the step, solved as non-penetration of the gap) must stop it.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Shared by the bad-input suites (test_badinput_*.cpp): the expectation that a call throws
 // std::invalid_argument whose message names the parameter and the offending value (STYLE: bad input names both,
 // and the object stays unchanged -- each suite checks that part itself).

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Bad input for the DIRECT solver's settings: std::invalid_argument naming the parameter and the value, the
 // solver unchanged.
 #include <doctest/doctest.h>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Bad input at the GranularFieldPostProcessor API boundary: std::invalid_argument naming the parameter and the
 // value, and the object unchanged.
 #include <doctest/doctest.h>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Bad input for constraints, controllers, materials and the simulation: std::invalid_argument naming the
 // parameter and the value, object unchanged.
 #include <doctest/doctest.h>

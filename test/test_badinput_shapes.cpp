@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Bad input at the shape/geometry API boundary: every constructor and setter rejects NaN, infinities,
 // negative and zero sizes with std::invalid_argument naming the parameter and the value, and a rejected
 // setter leaves the object unchanged.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain bad input: every rejected call throws std::invalid_argument with a message naming the problem, and
 // leaves the terrain unchanged (material map, compression, multipliers, parameters, heights and the ledger).
 #include <doctest/doctest.h>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Bad input for TwoBodyTireModel (issue 6): std::invalid_argument naming the parameter and the value, and the
 // model unchanged after a refused setter.
 #include <doctest/doctest.h>

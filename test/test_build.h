@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // What this build of Scree contains, for tests of an optional part (the DIRECT solver).
 //
 // CMake option SCREE_WITH_SUITESPARSE (default ON) builds the DIRECT solver on CHOLMOD and sets the compile

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Extreme parameters: the state must stay finite, the energy must not grow, and the bodies stay bounded.
 // "Energy not growing": kinetic + gravitational potential energy never exceeds its initial value by more than
 // 1e-6 J per kg plus 1e-9 relative (round-off); contact springs may store energy while compressed, which only

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Long particle runs (label extremes: not run under the sanitizers): 5,000 particles poured into a box settle,
 // and heaps poured on a plate steepen with rolling resistance.
 #include <doctest/doctest.h>

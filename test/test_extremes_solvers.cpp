@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Stability at the extremes for PGS and DIRECT (issue 4): mass ratios to 1:1e6 in a stack and in a chain, Young's
 // modulus 1e3..1e12 Pa on a resting box, time steps 1e-5..0.1 s, a 100 m/s impact, a 100-link chain, 1 and 1000
 // iterations. Each case asserts bounded behaviour (finite state, energy not growing, an error bound stated in

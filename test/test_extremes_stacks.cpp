@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Resting stacks at default settings (issue 18): a straight tower must not move sideways by itself.
 //
 // The sweep covers box sizes 0.1 / 0.6 / 2 m, densities 10 / 1000 / 10,000 kg/m^3 and 5 / 10 / 20 boxes (all 27

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The three models on the Model hook (scree/solver/model.h): TwoBodyTireModel, SuctionGripper and
 // GranularFieldStepListener. For each: added, it installs exactly its items (counted in the simulation's lists);
 // removed, the lists are as before the model came, the model is released, and a box dropped afterwards moves to

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // GranularFieldPostProcessor (manual §25.3): mass conservation, exact partial weights (corner 1/8, face 1/2,
 // boundary fractions, Monte Carlo), momentum and velocity of a translating cloud, custom buffers, solid volume
 // fraction and kinetic stress against closed forms, the documented layout and placement, determinism over

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // SuctionGripper (manual 25.4): hold threshold m g = dp A, pump switch, Bernoulli lip pressure under leakage,
 // outside pressure scaling (Mars), seal counts against the lip geometry, distance fade, action = reaction, one
 // vacuum system for several cups, subclassing of VacuumSystem / SuctionCup / SuctionCupInteraction, bad input.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain: construction checks, d = 0 equals a plain height field bit for bit, the compression multiplier law
 // (formula, per-step bound, depth for max compression), locked borders, a rolling wheel's ruts, and the volume
 // ledger after every step of every scene.

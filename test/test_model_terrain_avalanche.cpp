@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain avalanches and the angle of repose (terrain.h, "Dynamic height field: avalanches and the angle of
 // repose"; manual 25.1.2.15, 25.1.2.19, 25.1.2.20): avalancheAll on a tall column and a random rough field ends
 // with every 8-neighbour pair within repose, the volume exact and the heap's flanks at the angle of repose;

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain deformers (terrain.h, "Dynamic height field: deformers"; manual 25.1.2.15-25.1.2.18): the generated
 // vertical contact's Young's modulus E max(1, A/s_v) for two overlap areas; a deformer box resting with
 // useContactDepth true settles at the depth its vertical contacts' compliance predicts, with false its vertical

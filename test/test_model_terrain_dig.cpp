@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain digging (terrain.h, "Digging"): a kinematic bucket digs, lifts, dumps and the heap merges back with the
 // volume ledger constant after every step; particle mass = bulk density x particle account; the FCC lattice's
 // neighbour overlap r(sqrt2 - 1); particles only above the shovel plane + r; the minimum dig angle; bad input.

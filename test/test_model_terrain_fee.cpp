@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Digging force against the fundamental earthmoving equation (FEE; docs/terrain.md, "Digging force against the
 // fundamental earthmoving equation"; scene: bench/scenes/terrain_fee.h). A flat kinematic blade is pushed 0.3 m at
 // constant depth d and speed through cohesionless terrain that digs into particles, for d = 3, 5, 7 cm, widths

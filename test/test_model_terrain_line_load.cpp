@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // A wheel's line of contact is a line load on the terrain (terrain.h, "Line contacts are line loads"): the two
 // end points of a lying cylinder's generator line are spread over the segment between them, so every vertex under
 // the tire's width carries its share, with the points' total and moment kept exactly; a long cylinder sinks

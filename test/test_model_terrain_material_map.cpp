@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain material map: a two-material PNG maps each vertex to the right material in both image axes (column =
 // +x, top row = highest y), unmapped vertices use the terrain geometry's material, and contacts take their
 // parameters from the material of the vertex under them. The ledger is read after every step.

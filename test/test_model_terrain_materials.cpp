@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain particle contact materials (terrain.h, "External materials and particle solve type"): a steel bucket
 // registered as an external material carries its load; unregistered, the manual's FAQ failure (particles sink
 // into and fall through the blade) is reproduced and the warning names the material; E = max(...) of the

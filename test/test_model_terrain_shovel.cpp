@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain shovel read-outs and ground cutting force (terrain.h "Shovel read-outs", terrain_data_interface.h
 // "ground cutting force"): forces on a shovel against weights and Coulomb friction, the fill against the
 // particles the cut made, and the driver force of a dragged box against mu (1 + k) W and mu W + F.

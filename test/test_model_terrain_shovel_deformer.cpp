@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // A geometry that is both shovel and deformer (terrain.h, "A shovel that is also a deformer"; manual 25.1.2.13,
 // 25.1.2.15): driven through the soil it digs (particles) and pushes (a berm) with the soil ledger exact every
 // step; its ground cutting force is one friction-like row along forward, F against the motion; and the friction

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain sinkage against the law's closed form: a plate pressed quasi-statically settles at
 // z* = D ln(p/p0) / ((d+1) ln M) (terrain.h), grows with load, falls with deformability; a rolling wheel's
 // second pass over its rut sinks less than the first. The ledger is checked after every step.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // TwoBodyTireModel (issue 6, AGX manual 25.2) against closed-form mechanics: static deflection per mode,
 // free-vibration frequency and damping ratio per mode, a loaded wheel rolling at constant speed, torsional
 // wind-up under a driving motor, and the friction frame on the tire's contacts.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // TwoBodyTireModel in contact (issue 6): a loaded wheel rolling at constant speed on flat ground, torsional
 // wind-up of a wheel driven by a hinge motor against a load, and the friction frame on the tire's contacts.
 //

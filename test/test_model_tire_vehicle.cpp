@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // A four-wheeled vehicle on TwoBodyTireModel tires (issue 6; scene in bench/scenes/vehicle.h): static sag
 // per tire, driving on flat ground, and over a bump.
 #include <doctest/doctest.h>

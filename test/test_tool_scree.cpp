@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The scree program (examples/scree): `scree list` names every built-in scene, `scree run` runs one and prints
 // its metrics, and bad arguments fail with one line on stderr, a non-zero exit and no file. The executable's
 // path comes from CMake (SCREE_EXE).

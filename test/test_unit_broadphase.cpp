@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Broadphase and Space: the uniform grid reports exactly the brute-force overlapping pairs (once each,
 // sorted) with the work its cell size predicts, and the Space filters pairs by the documented rules and orders
 // its contacts by geometry id.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Contact events, sensors, collision groups, adhesion and contact modification by listeners.
 #include <doctest/doctest.h>
 

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Core utilities: logger levels and sink, property container, assert handler, material combination rules.
 #include <doctest/doctest.h>
 

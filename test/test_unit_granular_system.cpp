@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // GranularBodySystem container: stable ids across create/destroy/reorder, exact conservation of count and mass,
 // custom buffers following their particles, deferred destroys during iteration, and bad input.
 #include <doctest/doctest.h>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Shapes against height fields: flat, rotated/translated, and a sharp ridge. Tolerance 1e-9 throughout (all
 // height-field routines are analytic).
 #include <doctest/doctest.h>

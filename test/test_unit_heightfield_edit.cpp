@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // HeightField rectangle edits: values land where the layout says, bounds and tile bounds always equal a full
 // scan (exact: min/max of the same doubles), bad input changes nothing, batches defer the bounds.
 #include <doctest/doctest.h>

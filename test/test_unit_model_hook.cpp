@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The Model hook (scree/solver/model.h): a model installs bodies, geometries, constraints and listeners when it
 // is added, and removing it leaves the simulation as it was before, to the bit.
 #include <doctest/doctest.h>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Narrowphase pair routines: hand-computed depths, normals and points for resting, penetrating and speculative
 // configurations; the normal convention under swapped arguments; box-box manifolds and feature-id stability.
 // Analytic pairs are checked to 1e-9; libccd pairs to 1e-4 (MPR stops on a portal tolerance and converges

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // PNG material maps (model/src/png_index_map.h): exact round trips in every supported format, row 0 = the top
 // row of the image, and a clear std::invalid_argument naming `path` and the problem for every bad file --
 // including every truncation and every flipped byte of the image data, which must throw, never crash (run under

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The .screerec recording (docs/recording.md, scree/io/recording.h): a round trip is bit-identical (body poses
 // as the doubles the simulation held, particle data and heights as the float32 of each value), XOR deltas make an
 // unchanged frame nearly free, the writer leaves no partial file, and every truncation and single-bit corruption

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Shapes: volumes and mass properties against closed forms, body mass aggregation, AABBs, quickhull
 // invariants, height-field interpolation and the unequal-scale warning.
 //

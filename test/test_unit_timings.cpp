@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Simulation::getTimings(): the per-stage step times in milliseconds (StepTimings).
 #include <doctest/doctest.h>
 

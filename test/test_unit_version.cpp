@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The version has one source, project(Scree VERSION ...) in the root CMakeLists.txt (scree/version.h). This
 // suite checks that the three places a user reads it agree: scree::getVersionString() (compiled into the
 // library), the generated macros of scree/version_number.h, and the CMake package's ScreeConfigVersion.cmake

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // scree::io::writeViewerPage (scree/io/viewer_page.h): the C++ half of the replay page. The page itself is
 // tested in headless Chromium by test/test_viewer_page.py (label viewer); here: the embedding is exact (the
 // base64 text between the markers decodes to the recording's bytes, the title is the HTML-escaped file name),

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // VtkExporter (scree/io/vtk_export.h): a small scene (a rotated moving box, a sphere, particles with a custom
 // buffer, a terrain with a pressed vertex, a rotated granular field grid) written for two frames, then read back
 // by test/vtk_read.py under Debian's /usr/bin/python3 - VTK's own XML readers (vtkXMLPolyDataReader,

@@ -1,4 +1,6 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 """The replay page (scree/io/viewer_page.h) in headless Chromium, driven over the DevTools protocol.
 
   test_viewer_page.py --view-page BUILD/model/io/viewer/scree_view_page --chromium /usr/bin/chromium

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // TestWorld: a Simulation with one material and an explicit contact material, plus makers for the usual
 // bodies, so that each test case stays short. Built on the scene helpers of bench/scenes (same conventions:
 // z up, one Material on every geometry, contact material (mat, mat)).

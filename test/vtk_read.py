@@ -1,4 +1,6 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 """Reads a VtkExporter .pvd collection and every file it lists, and prints what they hold (test_unit_vtk_export).
 
 Run with Debian's /usr/bin/python3 (python3-vtk9, python3-meshio: scripts/install-deps.sh). Each file is decoded

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // spheres10k_jitter side by side: Bullet 3.24 (Debian's double-precision build, btDiscreteDynamicsWorld with the
 // sequential-impulse solver, 10 iterations, default settings otherwise) against Scree's GranularBodySystem on 1
 // and 2 threads, in one binary so that both are measured under the same machine load.

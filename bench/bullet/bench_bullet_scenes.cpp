@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The rigid reference scenes (docs/scenes.md: pyramid20, tower10, mass_ratio, chain20, slide, incline at mu 0.5
 // and 0.6)
 // side by side: Bullet 3.24 (Debian's double-precision build, btDiscreteDynamicsWorld with the sequential-impulse

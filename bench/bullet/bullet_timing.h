@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Shared by the Bullet side-by-side benches (bench_bullet_granular.cpp, bench_bullet_scenes.cpp): per-step
 // wall-clock timing of a run, so both binaries report Scree and Bullet the same way.
 #pragma once

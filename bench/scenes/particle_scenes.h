@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Particle scenes (GranularBodySystem): the spheres10k lattice as particles instead of rigid bodies, a pour,
 // a heap on a plate, and their metrics. Shared by bench/bench_granular.cpp, the granular tests and the demo.
 #pragma once

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Reference scene builders and metrics; see scenes.h and docs/scenes.md.
 #include "scenes/scenes.h"
 

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Reference scenes (defined in docs/scenes.md) and their accuracy metrics, shared by the benchmarks
 // (bench/bench_*.cpp), the tests (test/) and the examples. Every builder follows docs/scenes.md to the letter:
 //   z up, gravity (0, 0, -9.81), restitution 0, no damping, one scene Material carried by every body (static

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The trench scene (issue 16): a kinematic bucket digs a trench in a Terrain, lifts the soil, dumps it beside
 // the trench and the heap merges back into the height field. Shared by bench/bench_terrain_dig.cpp, the demo's
 // dig scene (examples/demo_dig.h) and examples/terrain_dig_trench.cpp.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The dozer scene (issue 17): a 2 m blade pushes soil across a Terrain with the dynamic height field on
 // (docs/terrain.md "Deformers", "Avalanches and the angle of repose"): the soil the blade overlaps is moved ahead
 // of it into a berm, and the berm's moved vertices avalanche toward their angle of repose. Shared by

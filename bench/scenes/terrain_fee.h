@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Digging-force scene against the fundamental earthmoving equation (FEE; docs/terrain.md, "Digging force against
 // the fundamental earthmoving equation"): a flat blade of width w, rake alpha (from the horizontal), kinematic,
 // its cutting edge held at depth d, pushed at constant speed along +x through cohesionless terrain that digs

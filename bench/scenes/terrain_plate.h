@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Plate-load (bevameter) scene on a Terrain: an n x n terrain (cells s) entirely under a bed of n x n pistons,
 // one small sphere above each vertex, guided vertically by a Prismatic to the world and weighing p s^2, so every
 // vertex carries the pressure p (no plate edge, no statically indeterminate load sharing between the points of

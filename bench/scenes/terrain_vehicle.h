@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The four-wheeled vehicle of vehicle.h (TwoBodyTireModel tires) on a height-field ground instead of the plane:
 // either a plain HeightField or a deformable Terrain on the same field (bench/bench_terrain.cpp, the demo's
 // terrain scene). The ground is a soil material whose contact with the vehicle's material has a soil-like

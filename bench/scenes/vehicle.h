@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Four-wheeled vehicle on TwoBodyTireModel tires (issue 6), shared by the tire tests, bench/bench_tire.cpp
 // and the demo. Not one of docs/scenes.md's reference scenes; it uses the scene conventions (z up, g 9.81, one
 // scene material, explicit contact material).

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Box-box: separating-axis test over the 15 axes (3 + 3 face normals, 9 edge-edge cross products; Gottschalk's
 // OBB test as given in Ericson, RTCD 4.4.1), then a contact manifold:
 //  - face axis: the reference face is the chosen box's face along the axis, the incident face the other box's

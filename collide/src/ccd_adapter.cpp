@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // libccd adapter: the only file that includes libccd (docs/design.md §1).
 //
 // Used for the convex pairs without an analytic routine (cylinder-cylinder, cylinder-box, cylinder-capsule,

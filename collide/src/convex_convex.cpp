@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Convex polytopes: convex-convex, convex-box (the box through an 8-vertex adapter), convex-plane, and the
 // clipping helpers shared with box-box.
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Contact manifolds for every convex pair from one penetration normal (narrowphase_internal.h,
 // "support-feature manifolds"; docs/design.md "Contact manifolds for every convex pair").
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Cylinder-box: a cylinder cap lying on a box face gets a full manifold (this analytic path: exact disc-rectangle
 // candidates, faster than clipping the cap polygon); every other configuration goes through the support-feature
 // manifold (convex_manifold.cpp: a cylinder lying on a face gets its side line clipped to the face), else keeps

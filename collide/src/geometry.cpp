@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Geometry: placement, ids, materials and collision groups.
 //
 // Choices written down here (the header is silent):

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Shapes against a HeightField. All work happens in the height field's frame (so rotated and translated height
 // fields behave like the axis-aligned one) and results are rotated back to the world.
 //

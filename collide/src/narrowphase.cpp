@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Narrowphase dispatch and the simple analytic pairs (sphere, capsule, cylinder, box-plane, line sensors).
 //
 // The table maps (Shape::Type, Shape::Type) to one routine written for a canonical order; the reverse order

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Private helpers shared by the narrowphase files (narrowphase.cpp, box_box.cpp, convex_convex.cpp,
 // heightfield_collide.cpp, ccd_adapter.cpp). Not installed.
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Collision shapes: validation, volumes, exact mass properties, bounding boxes, support mappings, and the
 // quickhull used by Convex.
 //

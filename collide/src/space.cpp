@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Space: pair filtering, speculative AABBs, broadphase and narrowphase dispatch.
 //
 // Speculative margin per geometry (so fast bodies produce contacts before they tunnel):

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Hashed uniform grid (after Teschner et al. 2003, "Optimized spatial hashing for collision detection of
 // deformable objects"; the cell hash itself differs, see cellHash).
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // scree: the command-line program. `scree list` prints the built-in scenes (scene_registry.h); `scree run SCENE`
 // runs one with a progress bar (a plain line per second when stdout is not a terminal) and ends with a summary:
 // the median wall time per step, the scene's metrics, the solver's statistics and the per-stage timings

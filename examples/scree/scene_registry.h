@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The scenes `scree list` shows and `scree run` runs. Each entry wraps a builder that already exists (the
 // reference scenes of docs/scenes.md in bench/scenes/, the terrain scenes in bench/scenes/terrain_*.h, the
 // suction pick-and-place and the granular pile of examples/demo_*.h): no scene is defined here, only how to

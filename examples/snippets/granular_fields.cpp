@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Granular fields on a voxel grid (docs/granular-fields.md); examples/granular_fields.cpp is a longer example.
 #include <cstdio>
 #include <scree/scree.h>

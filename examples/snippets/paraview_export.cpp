@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The C++ fragment of docs/paraview.md, between "// [doc]" and "// [/doc]": a small terrain, a few falling
 // particles and their granular fields exported for ParaView into out/ (60 frames).
 #include <cstdio>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Granular particles: a block of 1,000 sand grains dropped onto the ground (docs/particles.md).
 #include <cstdio>
 #include <scree/scree.h>

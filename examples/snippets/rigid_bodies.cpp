@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Contact materials, a sliding box and a pendulum on a hinge (docs/rigid-bodies.md).
 #include <cmath>
 #include <cstdio>

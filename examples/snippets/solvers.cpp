@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Where rows are solved, and how hard (docs/solvers.md).
 #include <cstdio>
 #include <scree/scree.h>

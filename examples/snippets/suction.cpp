@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // A suction cup on a kinematic holder lifts a 2 kg box (docs/suction.md).
 #include <cstdio>
 #include <scree/scree.h>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The C++ fragments of docs/terrain.md, each between "// [doc]" and "// [/doc]", compiled in context.
 // Compile-only (test_docs_snippets does not run it): the set-up reads a material map "map.png" that the page
 // only names; the terrain examples (examples/terrain_*.cpp) and test_model_terrain* run the same calls.

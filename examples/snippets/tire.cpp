@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // A wheel on a TwoBodyTireModel tire carrying a 350 kg load: the tire's radial deflection is load / k
 // (docs/tire.md).
 #include <cstdio>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // GranularFieldPostProcessor: voxelisation with exact sphere–box weights (see the header for the layout and
 // the field definitions).
 #include "scree/model/granular_field_post_processor.h"

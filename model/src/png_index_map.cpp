@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // PNG material maps through libpng (see png_index_map.h for the formats and the error contract).
 //
 // Error handling. libpng reports a fatal error by calling the error callback and then longjmp-ing to the

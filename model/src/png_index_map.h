@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // PNG material maps: an image whose pixel values are material indices (the AGX manual's
 // `TerrainDataInterface::setMaterialMapping(filePath)`). Internal to scree_model; the terrain maps image pixels
 // to height-field vertices, this file only decodes and encodes the index grid.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Closed-form ball–box intersection volume (see the header for the decomposition).
 //
 // Derivation of the z-antiderivative. For s >= 0 let rho(z) = sqrt(r^2 - z^2), k = sqrt(r^2 - s^2) and

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Exact volume of the intersection of a ball with an axis-aligned box, in closed form.
 //
 // Used by GranularFieldPostProcessor: a particle's weight in a voxel is the fraction of its volume inside the

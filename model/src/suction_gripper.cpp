@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // SuctionGripper, SuctionCup, VacuumSystem, SuctionCupInteraction (model layer; see suction_gripper.h).
 //
 // The gripper attaches through public hooks only: the Model hook installs (and removal takes out) its items;

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain: construction checks, the contact listener (per-point Young's modulus and material), the post-step
 // compression yield and the volume ledger. The law and its closed form are in terrain.h.
 #include "scree/model/terrain.h"

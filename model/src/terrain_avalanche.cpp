@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain avalanches (manual 25.1.2.15, 25.1.2.19, 25.1.2.20): arming, the per-step pass over the armed
 // vertices, avalancheAll, the angle of repose with wetness. The rules and why are in terrain.h's file comment
 // ("Dynamic height field: avalanches and the angle of repose"); every move goes through the volume ledger.

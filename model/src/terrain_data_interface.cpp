@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // TerrainDataInterface: per-vertex material index, compression and multiplier, and the compression parameters.
 #include "scree/model/terrain_data_interface.h"
 

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain: the dynamic height field's deformers (manual 25.1.2.15-25.1.2.18): generated vertical and horizontal
 // contacts with area-scaled Young's moduli, and volume-conserving pushing of the overlapped soil into a berm.
 // The law and its readings are in terrain.h ("Dynamic height field: deformers").

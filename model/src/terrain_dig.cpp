@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain digging: shovel discovery and validation, the cut, particle creation on the FCC lattice and merging
 // back (the rules are in terrain.h's file comment; the volume moves through the ledger, never created or lost).
 #include <algorithm>

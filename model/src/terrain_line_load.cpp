@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain: gathering the contacts' normal loads onto the grid vertices (terrain.h, "Line contacts are line
 // loads"). A point's load is split onto the three vertices of its triangle by barycentric weights; the points of
 // a lying cylinder's or capsule's contact are read as one line load along its axis over their axial extent, a

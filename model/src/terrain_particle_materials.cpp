@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain particle contact materials (terrain.h, "External materials and particle solve type"): the contact
 // material of each terrain-particle material with itself (particle adhesion, the Young's multiplier, the
 // particle friction solve type) and with every external material, the settings that drive them, and the

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain shovel read-outs (digging force and fill, TerrainShovelStats in terrain.h) and the ground cutting force
 // (TerrainDataInterface::setShovelGroundCuttingForce). The definitions and the reasons for them are in the
 // headers; this file only reads the step's contact lists and adjusts shovel-terrain contact points.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Private access to RigidBody internals for the integrator and the simulation (solver-private).
 #pragma once
 

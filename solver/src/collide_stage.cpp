@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The collision stages: geometry bookkeeping, the Space's broadphase and narrowphase, particle collision and
 // the contact materials. With the contact events, the only solver files that use collide headers beyond the
 // Simulation's own (the rest of the step sees contacts, rows and bodies).

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 #include "scree/solver/constraint.h"
 
 #include "scree/core/errors.h"

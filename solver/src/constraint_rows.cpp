@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Constraint rows stage: the rows of every enabled joint and model constraint with a dynamic body, after the
 // contact rows; a constraint whose rows report a separation (drift beyond Solver::getConstraintErrorThreshold)
 // is listed in the step report and logged once.

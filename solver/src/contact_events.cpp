@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Contact events stage: impact (first step a pair touches), contact (later steps) and separation (the step
 // after the last) reach the ContactEventListeners, which may modify or remove contacts before the rows are
 // built. Speculative-only contacts (every point a gap) are solved but raise no event.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The contact law (solver-private): the one place where a contact point's material and state become the
 // coefficients of its normal row, for rigid contacts (contact_rows.cpp) and particle contacts
 // (granular_stage.cpp) alike, plus the point Jacobian and the disc projection both contact paths share.

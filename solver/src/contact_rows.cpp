@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Contact rows stage (layout and warm start: contact_rows.h; the normal-row law: contact_law.h), and the
 // particle rows stage, which hands this step's particle contacts to the particle stage (granular_stage.h).
 #include "contact_rows.h"

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Contact rows and their warm-start cache (solver-private; built by contact_rows.cpp, read back by
 // store_results.cpp).
 //

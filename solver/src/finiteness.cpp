@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Finiteness check stage: a body whose state turned non-finite in this step is restored to its pose at the
 // start of the step and stopped, reported in the step report and logged (no exceptions inside the step).
 #include <sstream>

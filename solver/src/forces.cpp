@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Forces stage: the free velocities v + h M^-1 f of every dynamic body (external forces, gravity, velocity
 // damping) and particle (gravity), the start of the velocity solve. Gyroscopic effects are handled by the
 // rotation integrator (integrator.h), not as a torque here. The stage also keeps what later stages need of

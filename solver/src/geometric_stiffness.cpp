@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Geometric stiffness of direct-set joint rows (Solver::setUseGeometricStiffness), read by the solve stage
 // and by the position projection.
 #include <cmath>

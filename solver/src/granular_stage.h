@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // GranularStage: the particle path of Simulation::stepForward after collision (internal to the solver module).
 // The particle contact lists come from the collide stage (ParticleCollider, collide_stage.cpp); this stage
 // turns them into contact units, solves and integrates them. It includes no collide header: what it needs of a

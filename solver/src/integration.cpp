@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Integration stage: positions and rotations from the solved velocities (integrator.h), for dynamic bodies,
 // kinematic bodies (their prescribed velocities) and particles. External forces are cleared for the next step.
 #include "integrator.h"

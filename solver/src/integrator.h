@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Position/orientation update after the velocity solve (solver-private).
 //
 // Translation: symplectic Euler, x += h v+ (so free fall follows x_n = x_0 + n h v_0 + h^2 g n(n+1)/2 exactly).

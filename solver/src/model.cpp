@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Model add/remove hook (see scree/solver/model.h) and Simulation's model membership.
 #include "scree/solver/model.h"
 

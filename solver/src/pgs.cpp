@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Projected Gauss-Seidel sweeps and the rigid shock pass (pgs.h).
 //
 // DESIGN (issue 18, sweep cost; figures in docs/solver-internals.md "Sweep cost"):

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Position projection stage (Solver::setUsePositionProjection): post-stabilisation of rigid direct-set joint
 // rows after the positions are integrated.
 #include <algorithm>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Rolling radius of a geometry for rolling resistance (solver-private; rigid contacts in contact_rows.cpp, and
 // particle-geometry contacts through the collide stage, collide_stage.cpp): spheres, cylinders and capsules
 // roll, other shapes do not.

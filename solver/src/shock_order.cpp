@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Shock ordering: the support levels of the bodies and the order in which the shock-propagation pass
 // (PgsSolver::shockPass) visits the couplings, read by the solve stage.
 #include <algorithm>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Simulation: membership (bodies, geometries, constraints, listeners, settings) and stepForward, the step as a
 // sequence of named, timed stages. The stages live in the files step_stages.h lists; the state they share is
 // SimulationState (simulation_state.h).

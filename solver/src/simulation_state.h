@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The state of a Simulation shared by the stages of its step (solver-private). Simulation (simulation.cpp)
 // owns one and keeps membership in it; each stage (step_stages.h) reads and writes only the parts named for
 // it below. Grouped by stage so that a reader can see which stage owns which buffer; every buffer is reused

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Solve stage: the velocity solve of this step's rows and particle contact units, by one of four paths
 // chosen from what the step holds (docs/design.md §2 and §4):
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Step listeners (PRE_COLLIDE, PRE_STEP, POST_STEP stages): each listener whose mask has the bit, in the order
 // they were added; and the end of the particle deferral after the last of them.
 #include "step_stages.h"

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The stages of Simulation::stepForward (solver-private), in step order. Each does what its name says and is
 // timed on its own (StepStats); the file that defines it is named after it.
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Store-results stage: the solved impulses become the contact points' forces and next step's warm start, the
 // constraints' results (Constraint::storeResult) and the particle contacts' forces.
 #include <cmath>

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // External consumer of the Scree package: a 1 m box dropped onto a static ground box must come to rest on it.
 // Exit status 0 only when, after 1 s, the box's centre is at z = 0.5 m (ground top z = 0, half extent 0.5 m)
 // within 1 mm and it has (almost) stopped.

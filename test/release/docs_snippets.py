@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 """test_docs_snippets: every C++ code block the docs show is compiled code, and the compiled snippets run.
 
 The snippets are the files examples/snippets/*.cpp; test/CMakeLists.txt builds each as snippet_<name>. A file's

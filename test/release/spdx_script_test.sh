@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Copyright (c) 2026 The Scree authors
 # test_release_spdx_script: scripts/spdx-headers.sh on sample files in a temporary directory (not a git checkout,
 # so the script lists files with find). Checks each comment syntax, the shebang rule, the skipped paths (build
 # trees, node_modules, Markdown, HTML), --check's list and exit status, and that a second run changes nothing.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Version and the active build configuration as a runtime string.
 //
 // The version has one source: project(Scree VERSION x.y.z) in the root CMakeLists.txt. CMake writes it into the

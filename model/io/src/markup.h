@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Text escaping shared by the XML (VTK) and HTML (replay page) writers of Scree::io.
 #pragma once
 

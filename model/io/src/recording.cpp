@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The .screerec writer and reader (docs/recording.md; design notes in scree/io/recording.h).
 #include "scree/io/recording.h"
 

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // scree::io::writeViewerPage (scree/io/viewer_page.h). The template itself is generated at build time by
 // model/io/viewer/bundle.js into the build tree and linked into scree_io when the viewer is built
 // (SCREE_HAVE_VIEWER_PAGE).

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // VtkExporter (scree/io/vtk_export.h): hand-written VTK XML writers, binary appended (raw), and the .pvd.
 #include "scree/io/vtk_export.h"
 

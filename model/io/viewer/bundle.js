@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Build-time bundler of the replay page (run by node from model/io/viewer/CMakeLists.txt):
 //   node bundle.js TEMPLATE_HTML THREE_MODULE_JS OUT_HTML OUT_CPP VIEWER_JS...
 // 1. three.js: the npm package's ES module build (build/three.module.min.js, one file without imports in the

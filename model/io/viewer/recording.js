@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The replay page's reader of Scree recordings (docs/recording.md), written for the browser: chunks are
 // checked against their CRC-32 before anything is read from them, frames are inflated with the browser's
 // DecompressionStream("deflate") (zlib format), and XOR-delta particle arrays are undone frame by frame.

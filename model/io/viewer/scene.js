@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The replay page's scene: three.js objects for a parsed recording (recording.js) and the per-frame update.
 // Scree's z is up (camera.up = +z). Bodies are groups of meshes posed from the frame's f64 poses; particles
 // are one InstancedMesh (a low-poly sphere per particle, scaled by its radius, coloured by speed or by

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // scree_view_page RECORDING HTML: writes the replay page of a recording (scree::io::writeViewerPage). Used by
 // test/test_viewer_page.py so the test exercises the C++ embedding; `scree view FILE -o page.html` is the
 // user's command.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The replay page's controls: an orbit camera (drag: rotate about the target, shift-drag or right-drag: pan,
 // wheel: zoom; z stays up), play/pause, playback speed, the time scrubber, the frame counter and time.
 // Playback follows the recording's clock: at speed 1 a recording with a frame interval of 1/30 s shows 30

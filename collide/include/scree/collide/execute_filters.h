@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Filters for ContactEventListener (AGX: agxSDK::GeometryFilter, RigidBodyFilter, ExecuteFilter).
 // A listener with a filter hears only about pairs the filter matches.
 #pragma once

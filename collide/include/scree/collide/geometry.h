@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Geometry (AGX: agxCollide::Geometry): one shape placed in a body frame (or in the world when it has no
 // body), with a material, sensor flag, collision switch, collision groups and a property container. To its body
 // it is a BodyPart (scree/core/body_part.h): it gives its shape's mass properties in the body frame.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Narrowphase: contact points between two placed geometries.
 //
 // Dispatch is a table over (Shape::Type, Shape::Type). Analytic pairs first (sphere, box, capsule, plane,

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // ParticleCollider: contacts of GranularBodySystem particles with each other and with geometries.
 //
 // Broadphase: a hashed uniform grid over the particles, cell size = largest particle diameter + the pair

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Collision shapes (AGX: agxCollide::Sphere, Box, Capsule, Cylinder, Plane, Convex, HeightField, Line).
 // Every shape is expressed in its own frame; a Geometry places it. Capsule and Cylinder have their axis along
 // local y (AGX convention) and `height` is the length of the axis part (the cylinder's full height; the

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Space (AGX: agxCollide::Space): the set of geometries, pair filtering, the broadphase and the narrowphase.
 //
 // A pair is tested when both geometries have collisions enabled, they are not on the same body, at least one

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Uniform-grid broadphase.
 //
 // Finite AABBs are binned into cubic cells of a hashed grid (cell size chosen from the size distribution:

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // SCREE_ASSERT (cheap invariants, compiled in with SCREE_ENABLE_ASSERTS) and SCREE_VALIDATE (heavy consistency
 // checks, compiled in with SCREE_VALIDATE). A failed check calls the installed handler; the default handler
 // logs the message at ERROR level and aborts.

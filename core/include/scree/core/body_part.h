@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // BodyPart: what a RigidBody needs from the things attached to it, declared in core so that RigidBody's code
 // lives in core without knowing shapes. A Geometry (scree_collide) is the one implementation: it gives the mass
 // of its shape placed in the body frame and refreshes its world placement when it changes body.

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Collision group names (solver- and collide-internal): one registry maps a group name to its id, shared by
 // Geometry::addGroup(const std::string&) and GranularBodySystem::addGroup(const std::string&), so a name
 // means the same group for geometries and particles.

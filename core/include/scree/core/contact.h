@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Contact data written by the narrowphase, modified by contact listeners and read back after the step.
 #pragma once
 

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Validation helpers for the API boundary. Every public setter validates first and only then writes, so a
 // rejected call leaves the object unchanged. Messages name the function, the parameter and the value:
 //   "Sphere::setRadius: radius = -1 is invalid (must be > 0)".

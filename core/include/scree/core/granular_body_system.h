@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // GranularBodySystem (AGX: agx::GranularBodySystem): the particle container.
 //
 // Storage is structure-of-arrays: one contiguous array per attribute, indexed by a dense index

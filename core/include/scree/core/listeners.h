@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Listener interfaces (AGX: agxSDK::StepEventListener, agxSDK::ContactEventListener).
 #pragma once
 

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Project logger: levels and a replaceable sink. The default sink writes WARNING and above to stderr.
 // Thread-safe: the sink is called under a mutex.
 #pragma once

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Materials, contact materials and friction models (AGX: agx::Material, agx::ContactMaterial,
 // agx::MaterialManager, agx::FrictionModel).
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Scree core math: Eigen aliases and the rigid transform used everywhere.
 // Units are SI; the world is z-up.
 #pragma once

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Thread control for Scree's parallel stages (OpenMP when built with SCREE_WITH_OPENMP, serial otherwise).
 // Parallel stages are written so that their results do not depend on the number of threads (work split into
 // fixed chunks, per-chunk outputs merged in chunk order; the particle solver sweeps even spatial slabs, then odd

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Contacts involving particles (GranularBodySystem), as the collider produces them and the solver reports them.
 #pragma once
 

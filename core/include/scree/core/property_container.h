@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Named properties on a geometry (AGX's agx::PropertyContainer). The model layer keys on them, e.g. a
 // terrain shovel is a geometry with Vec3 properties "ShovelUpProperty" and "ShovelForwardProperty".
 #pragma once

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // RigidBody (AGX: agx::RigidBody).
 //
 // Frames: the body (model) frame is what get/setPosition and get/setRotation place. The centre of mass sits

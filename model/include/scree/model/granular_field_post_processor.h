@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Granular fields (AGX manual §25.3, agxModel::GranularFieldPostProcessor): continuum fields computed from the
 // particles of a GranularBodySystem on a voxel grid.
 //

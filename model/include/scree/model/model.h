@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The model layer (after the AGX agxModel chapter): models built from the public pieces of the layers below
 // (bodies, geometries, constraints, step and contact listeners) that join and leave a simulation as one unit.
 //

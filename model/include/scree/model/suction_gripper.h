@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // SuctionGripper (AGX: agxModel::SuctionGripper, manual section 25.4): a holder rigid body carrying suction cups
 // that one VacuumSystem powers.
 //

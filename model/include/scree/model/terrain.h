@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Terrain (AGX manual 25.1, agxModel::Terrain): a deformable height field. This part builds the terrain itself:
 // the material map, compression hardening under what rests on or rolls over it, locked borders, and the soil
 // volume ledger. Digging into particles and the dynamic height field with avalanches build on it.

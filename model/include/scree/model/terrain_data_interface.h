@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // TerrainDataInterface (AGX manual 25.1.1.1 and 25.1.2.1-25.1.2.4: agxModel::TerrainDataInterface): the
 // per-vertex data of a Terrain and the parameters of its compression law. Reached through
 // Terrain::getDataInterface(), which returns a reference (the manual's `->getDataInterface()->add(...)` is

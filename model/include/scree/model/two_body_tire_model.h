@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // TwoBodyTireModel (AGX manual 25.2, agxModel::TwoBodyTireModel): a tire body and a rim body joined by a
 // compliant 6-DOF constraint, so that the tire deflects against the rim under load.
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Constraint base class (AGX: agx::Constraint). A constraint between body A and body B (B may be null: the
 // world) contributes scalar rows per step. Each row (DOF) has its own SPOOK compliance and damping time
 // (defaults 1e-8 and 2/60 s, see spook.h); the force each row applied in the last step is readable per DOF.

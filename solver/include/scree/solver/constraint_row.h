@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // One scalar constraint row as the PGS and DIRECT solvers see it. Joints, contacts and models fill rows of
 // this form; solvers read only these and the body arrays (core types), so tests can feed hand-built rows.
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // DIRECT solver on SuiteSparse CHOLMOD (docs/design.md §4). Reads only core types and rows, like PGS, so tests can
 // feed hand-built systems.
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Joints (AGX: agx::BallJoint, Hinge, Prismatic, LockJoint, DistanceJoint, CylindricalJoint) and a generic
 // 6-DOF constraint whose DOFs can each be FREE, LOCKED or COMPLIANT (the tire model is built on it).
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Model: the one way a model (terrain, tire, granular field post-processor, suction gripper, or a user's own)
 // joins and leaves a Simulation.
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Projected Gauss-Seidel on the Schur form (docs/design.md §4). Reads only core types and rows, so tests can feed
 // hand-built systems.
 //

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Simulation (AGX: agxSDK::Simulation): owns the bodies, geometries, constraints and listeners, and runs
 // the step. stepForward() is a fixed pipeline of named stages (docs/design.md §2), each timed in StepStats:
 //   PRE_COLLIDE listeners; collision (geometries synced with the space, Space broadphase + narrowphase,

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Solver settings and per-step statistics (AGX: agx::Solver / agx::DynamicsSystem's solver knobs).
 #pragma once
 

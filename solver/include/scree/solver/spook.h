@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // SPOOK regularisation (Lacoursiere 2007), the one place where material/constraint parameters map to the
 // row coefficients. With time step h, compliance eps and damping time tau (d = tau/h):
 //   a = 4/(h(1+4d)),  Upsilon = 1/(1+4d),  e = 4 eps/(h^2 (1+4d))          (holonomic rows: joints, normals)

@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Little-endian byte buffers for Scree's file writers and readers (recording, VTK). The reader checks every
 // access against the end of its buffer and throws scree::io::FormatError naming what it was reading and the
 // byte offset, so a truncated or corrupted file is a clear error and never a read past the end.

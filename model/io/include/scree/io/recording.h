@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Recording of a run to a `.screerec` file and reading it back (the format: docs/recording.md).
 //
 // RecordingWriter. open(path) creates `path + ".part"`; begin(sim) writes the scene (SCNE), one HFLD per

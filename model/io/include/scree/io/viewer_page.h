@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The replay page written by `scree view FILE -o page.html`: one self-contained HTML file (three.js and the
 // page's scripts inlined at build time, the recording embedded in base64) that replays a recording
 // (docs/recording.md) offline in a browser with WebGL. The page reads the format itself (CRC-32 checks,

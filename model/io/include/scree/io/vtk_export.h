@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // ParaView export (issue 19): a time series of VTK XML files and one .pvd collection that lists them.
 //
 // Files. VtkExporter(dir, base) writes, per writeFrame() call number f (6 digits, from 0):
