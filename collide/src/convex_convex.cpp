@@ -29,17 +29,6 @@ namespace {
 constexpr Real kRelTol = 0.05;
 constexpr Real kAbsTol = 1e-5;
 
-uint32_t mix(uint32_t a, uint32_t b) {
-  // 32-bit hash combine (murmur3 finaliser on a simple fold).
-  uint32_t h = a * 0x9E3779B1u ^ (b + 0x7F4A7C15u + (a << 6) + (a >> 2));
-  h ^= h >> 16;
-  h *= 0x85EBCA6Bu;
-  h ^= h >> 13;
-  h *= 0xC2B2AE35u;
-  h ^= h >> 16;
-  return h;
-}
-
 struct Projection {
   Real lo, hi;
 };
@@ -230,7 +219,7 @@ int collidePolytopes(const Polytope& A, const Polytope& B, Real margin, std::vec
       Real s, t;
       closestSegmentSegment(a0, a1, b0, b1, s, t);
       const Vec3 ca = a0 + s * (a1 - a0), cb = b0 + t * (b1 - b0);
-      out.push_back(makeContact(Real(0.5) * (ca + cb), -nE, -sepE, 0x80000000u | (mix(uint32_t(ea), uint32_t(eb)) >> 1)));
+      out.push_back(makeContact(Real(0.5) * (ca + cb), -nE, -sepE, 0x80000000u | (hashFeatureIds(uint32_t(ea), uint32_t(eb)) >> 1)));
       return 1;
     }
   }
@@ -261,7 +250,7 @@ int collidePolytopes(const Polytope& A, const Polytope& B, Real margin, std::vec
   clipToReference(poly, ref.data(), int(ref.size()), nRef, scratch);
 
   const Vec3 normal = refIsB ? nRef : Vec3(-nRef);
-  const uint32_t base = mix(mix(uint32_t(refIsB), uint32_t(fr)), uint32_t(fi)) & 0x7FFFC000u;
+  const uint32_t base = hashFeatureIds(hashFeatureIds(uint32_t(refIsB), uint32_t(fr)), uint32_t(fi)) & 0x7FFFC000u;
   const size_t begin = out.size();
   for (const ClipVertex& v : poly) {
     const Real sep = nRef.dot(v.p) - RF.offset;

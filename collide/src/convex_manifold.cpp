@@ -78,16 +78,6 @@ struct Feature {
 
 inline uint32_t labelPair(uint32_t a, uint32_t b) { return a < b ? (a << 7) | b : (b << 7) | a; }
 
-uint32_t hashIds(uint32_t a, uint32_t b) {
-  uint32_t h = a * 0x9E3779B1u ^ (b + 0x7F4A7C15u + (a << 6) + (a >> 2));
-  h ^= h >> 16;
-  h *= 0x85EBCA6Bu;
-  h ^= h >> 13;
-  h *= 0xC2B2AE35u;
-  h ^= h >> 16;
-  return h;
-}
-
 Real polygonArea(const Feature& f) {
   Vec3 s = Vec3::Zero();
   for (int k = 0; k < f.count; ++k) s += f.p[size_t(k)].cross(f.p[size_t((k + 1) % f.count)]);
@@ -261,23 +251,27 @@ void supportFeature(const Shape& s, const Transform& t, const Vec3& d, Feature& 
   }
 }
 
+/// Keeps the part of segment a-b with sn . x <= so. Returns false when nothing remains; a cut end takes `label`.
+bool clipSegmentByPlane(Vec3& a, Vec3& b, uint8_t& la, uint8_t& lb, const Vec3& sn, Real so, uint8_t label) {
+  const Real da = sn.dot(a) - so, db = sn.dot(b) - so;
+  if (da > 0 && db > 0) return false;
+  if (da > 0) {
+    a = a + (da / (da - db)) * (b - a);
+    la = label;
+  } else if (db > 0) {
+    b = b + (db / (db - da)) * (a - b);
+    lb = label;
+  }
+  return true;
+}
+
 /// Clips segment a-b by the side planes of reference polygon `ref` (counter-clockwise about nRef). Returns false
 /// when nothing remains; labels: the original end (0, 1) or 64 + side plane.
 bool clipSegment(Vec3& a, Vec3& b, uint8_t& la, uint8_t& lb, const Vec3* ref, int n, const Vec3& nRef) {
   for (int k = 0; k < n; ++k) {
     const Vec3& r0 = ref[k];
     const Vec3 sn = (ref[(k + 1) % n] - r0).cross(nRef);
-    const Real so = sn.dot(r0);
-    const Real da = sn.dot(a) - so, db = sn.dot(b) - so;
-    if (da > 0 && db > 0) return false;
-    const uint8_t label = uint8_t(64 + (k & 63));
-    if (da > 0) {
-      a = a + (da / (da - db)) * (b - a);
-      la = label;
-    } else if (db > 0) {
-      b = b + (db / (db - da)) * (a - b);
-      lb = label;
-    }
+    if (!clipSegmentByPlane(a, b, la, lb, sn, sn.dot(r0), uint8_t(64 + (k & 63)))) return false;
   }
   return true;
 }
@@ -301,20 +295,8 @@ int manifoldFromNormal(const Shape& s0, const Transform& t0, const Shape& s1, co
     uint8_t la = 0, lb = 1;
     // End planes of segment B: x . ub >= p0 . ub and x . ub <= p1 . ub.
     const Real lo = ub.dot(fb.p[0]), hi = ub.dot(fb.p[1]);
-    auto clipPlane = [&](const Vec3& sn, Real so, uint8_t label) {
-      const Real da = sn.dot(a) - so, db = sn.dot(b) - so;
-      if (da > 0 && db > 0) return false;
-      if (da > 0) {
-        a = a + (da / (da - db)) * (b - a);
-        la = label;
-      } else if (db > 0) {
-        b = b + (db / (db - da)) * (a - b);
-        lb = label;
-      }
-      return true;
-    };
-    if (!clipPlane(-ub, -lo, 64) || !clipPlane(ub, hi, 65)) return 0;
-    const uint32_t base = hashIds(hashIds(2, fa.id), fb.id) & 0x7FFFC000u;
+    if (!clipSegmentByPlane(a, b, la, lb, -ub, -lo, 64) || !clipSegmentByPlane(a, b, la, lb, ub, hi, 65)) return 0;
+    const uint32_t base = hashFeatureIds(hashFeatureIds(2, fa.id), fb.id) & 0x7FFFC000u;
     const Vec3 pts[2] = {a, b};
     const uint8_t labels[2] = {la, lb};
     for (int k = 0; k < 2; ++k) {
@@ -355,7 +337,7 @@ int manifoldFromNormal(const Shape& s0, const Transform& t0, const Shape& s1, co
   }
   const Real refOffset = nRef.dot(R.p[0]);
   const Vec3 normal = refIsB ? nRef : Vec3(-nRef);
-  const uint32_t base = hashIds(hashIds(uint32_t(refIsB), fa.id), fb.id) & 0x7FFFC000u;
+  const uint32_t base = hashFeatureIds(hashFeatureIds(uint32_t(refIsB), fa.id), fb.id) & 0x7FFFC000u;
   // Clipping emits a point twice only where an incident vertex lies exactly on a side plane, and then the two
   // copies are neighbours in the clipped polygon: comparing with the last point kept (and the first, for the
   // wrap-around) removes them at O(1) per point.

@@ -109,6 +109,17 @@ inline bool nearExisting(const std::vector<ContactPoint>& out, size_t begin, con
     if ((out[k].point - x).cwiseAbs().maxCoeff() <= tol) return true;
   return false;
 }
+/// 32-bit hash combine of two feature ids (a murmur3 finaliser on a simple fold): the high bits of a manifold's
+/// persistent feature ids, shared by the hull-hull and the support-feature manifolds.
+inline uint32_t hashFeatureIds(uint32_t a, uint32_t b) {
+  uint32_t h = a * 0x9E3779B1u ^ (b + 0x7F4A7C15u + (a << 6) + (a >> 2));
+  h ^= h >> 16;
+  h *= 0x85EBCA6Bu;
+  h ^= h >> 13;
+  h *= 0xC2B2AE35u;
+  h ^= h >> 16;
+  return h;
+}
 /// Feature label of a clipped vertex (14 bits).
 inline uint32_t clipLabel(const ClipVertex& v) {
   const uint32_t a = v.la & 127, b = v.lb & 127;
