@@ -108,7 +108,7 @@ int collideCylinderBox(const Shape& s0, const Transform& t0, const Shape& s1, co
     out.push_back(single);
     return 1;
   }
-  return reduceManifold(out, begin, 4);
+  return reduceManifold(out, begin, 4, Real(1e-4) * r);
 }
 
 }  // namespace scree::detail

@@ -707,7 +707,7 @@ const Table& table() {
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------------------
-int reduceManifold(std::vector<ContactPoint>& out, size_t begin, int maxPoints) {
+int reduceManifold(std::vector<ContactPoint>& out, size_t begin, int maxPoints, Real depthTieTolerance) {
   const int n = int(out.size() - begin);
   if (n <= maxPoints) return n;
   const ContactPoint* c = out.data() + begin;
@@ -715,6 +715,14 @@ int reduceManifold(std::vector<ContactPoint>& out, size_t begin, int maxPoints) 
   int i0 = 0;
   for (int i = 1; i < n; ++i)
     if (c[i].depth > c[i0].depth) i0 = i;
+  if (depthTieTolerance > 0) {
+    const Real level = c[i0].depth - depthTieTolerance;
+    for (int i = 0; i < i0; ++i)
+      if (c[i].depth >= level) {
+        i0 = i;
+        break;
+      }
+  }
   int sel[4] = {i0, -1, -1, -1};
   int numSel = 1;
   if (maxPoints >= 2) {

@@ -34,7 +34,14 @@ inline ContactPoint makeContact(const Vec3& point, const Vec3& normal, Real dept
 /// Keeps at most `maxPoints` of out[begin..end) (in place, deepest first): the deepest point, the one farthest
 /// from it, then the two that span the largest signed area on either side of that segment (Gregorius, "Robust
 /// Contact Creation for Physics Simulations", GDC 2015). Returns the number kept.
-int reduceManifold(std::vector<ContactPoint>& out, size_t begin, int maxPoints = 4);
+///
+/// depthTieTolerance (m): points whose depth is within it of the deepest count as equally deep, and the first of
+/// them in emission order starts the selection. A cap resting level on a face or on another cap has all its rim
+/// points equally deep up to roundoff; without the tolerance the kept square turned from step to step (0, 15,
+/// 30, 45 degrees ...) with new feature ids, the warm start matched nothing and cylinder towers rang and drifted
+/// (test/test_extremes_stacks_cylinders.cpp). The cap routines pass 1e-4 x the cap radius (a tilt below 1e-4 rad
+/// across the cap counts as level) and emit their rim points in an order fixed in the cylinder's frame.
+int reduceManifold(std::vector<ContactPoint>& out, size_t begin, int maxPoints = 4, Real depthTieTolerance = 0);
 
 /// Closest points between segments p1-q1 and p2-q2 (Ericson, RTCD 5.1.9): outS, outT in [0, 1].
 void closestSegmentSegment(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, Real& outS, Real& outT);
