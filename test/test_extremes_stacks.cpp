@@ -21,18 +21,17 @@
 
 #include <scree/scree.h>
 
+#include "stack_column.h"
+
 using namespace scree;
+using stack_column::blockPosition;
+using stack_column::name;
+using stack_column::observe;
+using stack_column::pairStiffness;
+using stack_column::Placement;
+using stack_column::TowerResult;
 
 namespace {
-
-enum class Placement { ALIGNED, OFFSET, GAP };
-
-struct TowerResult {
-  Real maxHorizontalDrift = 0;  ///< m, largest horizontal distance of any box from its start, over the run
-  Real maxHorizontalSpeed = 0;  ///< m/s, largest horizontal speed of any box, over the run
-  Real topDrop = 0;             ///< m, how far the top box ended below its start
-  bool finite = true;
-};
 
 /// manifolds: 1 switches both manifold options on, 0 off, -1 (default) keeps the Solver's defaults.
 TowerResult runTower(Real size, Real density, int count, Real mu, Placement placement, Real seconds,
@@ -57,7 +56,6 @@ TowerResult runTower(Real size, Real density, int count, Real mu, Placement plac
   ground->setMaterial(mat);
   sim.add(ground);
   const Real half = size / 2;
-  const Real gap = placement == Placement::GAP ? 1e-3 : 0.0;
   std::vector<RigidBodyRef> boxes;
   std::vector<Vec3> start;
   for (int i = 0; i < count; ++i) {
@@ -65,8 +63,7 @@ TowerResult runTower(Real size, Real density, int count, Real mu, Placement plac
     g->setMaterial(mat);
     auto b = std::make_shared<RigidBody>();
     b->add(g);
-    Vec3 p(0, 0, half + (size + gap) * i + gap);
-    if (placement == Placement::OFFSET) p += Vec3(1e-3 * ((i % 3) - 1), 5e-4 * ((i % 2) ? 1 : -1), 0);
+    const Vec3 p = blockPosition(size, i, placement);
     b->setPosition(p);
     sim.add(b);
     boxes.push_back(b);
@@ -77,12 +74,7 @@ TowerResult runTower(Real size, Real density, int count, Real mu, Placement plac
   const int traceSteps = traceEvery > 0 ? int(std::lround(traceEvery / h)) : 0;
   for (int s = 0; s < steps; ++s) {
     sim.stepForward();
-    for (int i = 0; i < count; ++i) {
-      const Vec3 p = boxes[i]->getPosition(), v = boxes[i]->getVelocity();
-      r.finite &= p.allFinite() && v.allFinite();
-      r.maxHorizontalDrift = std::max(r.maxHorizontalDrift, (p - start[i]).head<2>().norm());
-      r.maxHorizontalSpeed = std::max(r.maxHorizontalSpeed, v.head<2>().norm());
-    }
+    observe(r, boxes, start);
     if (driftTrace && traceSteps > 0 && (s + 1) % traceSteps == 0)
       driftTrace->push_back({(s + 1) * h, r.maxHorizontalDrift});
   }
@@ -97,51 +89,23 @@ TowerResult runTower(Real size, Real density, int count, Real mu, Placement plac
 // (docs/design.md §3), so the static state is that of linear springs. Two equal materials combine in series:
 // k = E/2 (core/src/material.cpp).
 
-/// Contact stiffness per point between two boxes of the same material of Young's modulus E.
-Real pairStiffness(Real youngsModulus) { return youngsModulus * youngsModulus / (youngsModulus + youngsModulus); }
-
-/// Static sink of the top box: joint j (0 = ground) carries the n - j boxes above it on 4 springs, so it closes
-/// (n - j) m g / (4 k); the top box sinks by the sum, m g / (4 k) * n (n + 1) / 2.
+/// Static sink of the top box: joint j (0 = ground) carries the n - j boxes above it on 4 springs
+/// (stack_column.h).
 Real complianceSink(Real size, Real density, int count, Real g, Real k) {
-  const Real m = density * size * size * size;
-  return m * g / (4 * k) * count * (count + 1) / 2.0;
+  return stack_column::complianceSink(density * size * size * size, count, g, k, 4);
 }
 
-/// The smallest point stiffness k at which the column stands (its linearised potential is positive definite).
-///
-/// Tilts theta_j of the boxes (j = 0 at the bottom, rotations about the face centres; friction holds the joints
-/// horizontally, and a tilted column under gravity needs no shear to first order). Joint j is a 4-point face of
-/// half width a = s/2: its rotational stiffness is k_theta = sum k r^2 = 4 k a^2 (about either face axis), and
-/// it stores k_theta (theta_j - theta_{j-1})^2 / 2 (theta_{-1} = 0, the ground). Gravity lowers box i's centre
-/// by s theta_j^2 / 2 for every box j below it and by s theta_i^2 / 4 for its own tilt, so the potential is
-///   V = theta^T (k_theta T - G) theta / 2,   T = tridiag(-1, 2, -1) with T_{n-1,n-1} = 1,
-///   G = diag(m g s (n - j - 1/2)).
-/// The column stands iff k_theta T - G is positive definite: no negative pivot in its LDL^T (Sylvester). The
-/// critical k is found by bisection on that pivot count. (The continuous limit is Greenhill's heavy column,
-/// q L^3 / EI = 7.84 with q = m g / s, L = n s, EI = k_theta s.)
+/// Tilts theta_j of the boxes rotate about the face centres (friction holds the joints horizontally, and a tilted
+/// column under gravity needs no shear to first order). Joint j is a 4-point face of half width a = s/2: its
+/// rotational stiffness is k_theta = sum k r^2 = 4 k a^2 about either face axis; stack_column.h has the
+/// column's potential and its pivot test.
 bool columnStands(Real size, Real density, int count, Real g, Real k) {
-  const Real m = density * size * size * size;
-  const Real kTheta = 4 * k * (size / 2) * (size / 2);
-  Real pivot = 0;
-  for (int j = 0; j < count; ++j) {
-    const Real d = (j < count - 1 ? 2 * kTheta : kTheta) - m * g * size * (count - j - 0.5);
-    pivot = j == 0 ? d : d - kTheta * kTheta / pivot;
-    if (pivot <= 0) return false;
-  }
-  return true;
+  return stack_column::columnStands(density * size * size * size, size, count, g, 4 * k * (size / 2) * (size / 2));
 }
 
+/// The smallest point stiffness k at which the column stands.
 Real bucklingStiffness(Real size, Real density, int count, Real g) {
-  Real lo = 1e-6, hi = 1e16;  // N/m per point; columnStands(lo) is false, columnStands(hi) true for the sweep
-  for (int i = 0; i < 200; ++i) {
-    const Real mid = std::sqrt(lo * hi);
-    (columnStands(size, density, count, g, mid) ? hi : lo) = mid;
-  }
-  return hi;
-}
-
-std::string name(Placement p) {
-  return p == Placement::ALIGNED ? "aligned" : p == Placement::OFFSET ? "mm offsets" : "1 mm gaps";
+  return stack_column::bucklingStiffness(density * size * size * size, size, count, g, 4 * (size / 2) * (size / 2));
 }
 
 }  // namespace

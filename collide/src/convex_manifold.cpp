@@ -446,8 +446,12 @@ int collideCcdManifold(const Shape& s0, const Transform& t0, const Shape& s1, co
                        std::vector<ContactPoint>& out) {
   const size_t begin = out.size();
   if (collideCcd(s0, t0, s1, t1, margin, out) != 1) return int(out.size() - begin);
-  const ContactPoint single = out.back();
-  out.pop_back();
+  return manifoldOrSinglePoint(s0, t0, s1, t1, out.back(), margin, out, begin);
+}
+
+int manifoldOrSinglePoint(const Shape& s0, const Transform& t0, const Shape& s1, const Transform& t1,
+                          const ContactPoint single, Real margin, std::vector<ContactPoint>& out, size_t begin) {
+  out.resize(begin);
   const int m = manifoldFromNormal(s0, t0, s1, t1, single.normal, margin, out);
   if (m > 0) return m;
   out.resize(begin);

@@ -28,14 +28,7 @@ int collideCylinderBox(const Shape& s0, const Transform& t0, const Shape& s1, co
   const ContactPoint single = out.back();
   // Every other configuration (a wheel lying on a face, a tilted cylinder on an edge): the support-feature
   // manifold (convex_manifold.cpp), else the single point.
-  auto generic = [&]() {
-    out.pop_back();
-    const int m = manifoldFromNormal(s0, t0, s1, t1, single.normal, margin, out);
-    if (m > 0) return m;
-    out.resize(begin);
-    out.push_back(single);
-    return 1;
-  };
+  auto generic = [&]() { return manifoldOrSinglePoint(s0, t0, s1, t1, single, margin, out, begin); };
 
   const auto& cyl = static_cast<const Cylinder&>(s0);
   const Vec3& he = static_cast<const Box&>(s1).getHalfExtents();

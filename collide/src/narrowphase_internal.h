@@ -158,6 +158,10 @@ int manifoldFromNormal(const Shape& s0, const Transform& t0, const Shape& s1, co
 /// collideCcd, then manifoldFromNormal along its normal (the single point when no manifold results).
 int collideCcdManifold(const Shape&, const Transform&, const Shape&, const Transform&, Real,
                        std::vector<ContactPoint>&);
+/// out[begin, end) holds libccd's single point `single` (a copy: out is rewritten): replaces it by
+/// manifoldFromNormal along its normal, or keeps it when no manifold results. Returns the number of points.
+int manifoldOrSinglePoint(const Shape& s0, const Transform& t0, const Shape& s1, const Transform& t1,
+                          const ContactPoint single, Real margin, std::vector<ContactPoint>& out, size_t begin);
 
 /// Shape vs height field: the normal points out of the height field (from shape 1 towards shape 0).
 int collideSphereHeightField(const Shape&, const Transform&, const Shape&, const Transform&, Real,
