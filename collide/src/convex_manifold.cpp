@@ -425,6 +425,7 @@ int manifoldFromNormal(const Shape& s0, const Transform& t0, const Shape& s1, co
       }
       if (inside) emitFromD(y, labelPair(uint32_t(64 + (j & 63)), 127));
     }
+    levelDepths(out, begin, Real(1e-12) * (1 + c.cwiseAbs().maxCoeff()));
     return reduceManifold(out, begin, 4, Real(1e-4) * D.radius);
   }
   if (I.count == 2) {

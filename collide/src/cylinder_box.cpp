@@ -101,6 +101,7 @@ int collideCylinderBox(const Shape& s0, const Transform& t0, const Shape& s1, co
     out.push_back(single);
     return 1;
   }
+  levelDepths(out, begin, Real(1e-12) * (1 + cc.cwiseAbs().maxCoeff()));
   return reduceManifold(out, begin, 4, Real(1e-4) * r);
 }
 
