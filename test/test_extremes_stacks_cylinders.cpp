@@ -170,27 +170,28 @@ TEST_CASE("an upright cylinder's cap-cap and cap-box manifolds at rest are 4 rim
 // aligned one keeps every horizontal speed below 1e-9 m/s; a tower past its buckling load with mm offsets must
 // lean over (> 1 cm). By columnStands only 20 x 2 m x 10,000 kg/m^3 is past its buckling load (k = 2e8 against
 // k_crit = 6.8e8 N/m per point; the box's is 4.3e8); as in the box sweep its aligned and gapped towers count among
-// those that must stand (an unstable equilibrium nothing disturbs).
+// those that must stand within 1 cm (an unstable equilibrium nothing disturbs much in 30 s).
 //
-// KNOWN FAILURE, bounds NOT loosened: this case is marked should_fail because cylinder towers do not meet the
-// box sweep's bounds yet (issue 20 stays open on it). Measured at default settings (30 s, 10 s of CPU for all 81).
-// First run: 66 of 80 towers that must stand stayed within 1 cm; 14 did not, all 2 m towers of >= 1000 kg/m^3
-// except 5 x 2 m x 1000, though all but one are stable by columnStands with margin. Not the solver's
-// convergence: 10 x 2 m x 1000 aligned drifted 15.7 mm at 16 iterations, 25.9 mm at 64, 9.4 mm with DIRECT
-// contacts. One cause found: the cap manifolds kept a different 4 of the equally deep rim points every step
-// (new feature ids, so no warm start): reduceManifold's depth tie tolerance (narrowphase_internal.h) now keeps
-// the same 4. A second: a level cap placed touching got rim depths of +-5.6e-17 m from the rotation's roundoff,
-// i.e. overlap rows on one side and speculative rows on the other, and tipped at the first step (1.3e-5 m/s);
-// levelDepths now evens out depths that differ by roundoff only, and a single cylinder stays at 1e-20 m/s. Now:
-// 69 of 80 towers that must stand stay within 1 cm; 11 do not (20 x 0.6 m x 10,000 mu 1 aligned / gaps 30 /
-// 67 mm; 10 x 2 m x 1000 mu 0.3 aligned / gaps 11 / 13 mm; 20 x 2 m x 1000 aligned / gaps 177 / 78 mm; 5 x 2 m x
-// 10,000 gaps 11 mm; 10 x 2 m x 10,000 aligned / gaps 0.12 / 0.89 m; 20 x 2 m x 10,000 aligned and gapped
-// collapse); 6 of the 27 aligned towers move sideways faster than 1e-9 m/s and 15 towers miss the sink bound.
-// What still drives the heavy towers is not found yet. The offset 20 x 2 m x 10,000 tower does lean over, as it
-// must. When the cylinder towers meet the bounds this case fails as should_fail; then remove the decorator.
+// One departure from the box sweep, by the same closed form: the aligned tower past its buckling load is not held
+// to the 1e-9 m/s bound. A box tower at the identity rotation is exactly symmetric; an upright cylinder is turned
+// by a quaternion whose rim points carry roundoff of ~1e-17 m, and past the buckling load that seed grows
+// exponentially (measured: drift 1.4e-12 m at 5 s, then x7 every 5 s, 1.4e-6 m and 4e-7 m/s at 30 s), while every
+// stable aligned tower stays below 3.2e-10 m/s. It still has to stand within 1 cm and sink by the closed form.
+//
+// What it took (measured before the fixes: 69 of 80 standing, 15 missing the sink bound, 6 of 27 aligned above
+// 1e-9 m/s): (1) a cap on a cap kept, step by step, whichever copy of a doubled rim point roundoff chose (P's rim
+// vertex, an edge crossing at t = 0 or 1, or D's rim point), so a point got a new feature id and, while the tower
+// still settled faster than the warm start's 1e-5 m position fallback, started from zero while the others kept
+// their impulse: the unequal start tipped the heavy towers (first sideways motion at step 8 of 10 x 2 m x 1000,
+// at the top joint's re-labelled point). The cap-on-cap branch of convex_manifold.cpp now gives the boundary band
+// to the reference cap. (2) the 2 m cylinders' bottom caps rested on the ground at a depth of -2.8e-17 m
+// (rotation roundoff): speculative rows, i.e. a rigid support that never sank (the sink was exactly the closed
+// form without the ground joint's term); levelDepths now sets a level depth within roundoff of 0 to 0.
+// Measured now (30 s, ~10 s of CPU for all 81): 80 of 80 stand (worst drift 1.4 mm), worst sink error 4.0e-7 m,
+// the 26 stable aligned towers below 1e-9 m/s (worst 3.1e-10 m/s, 10 x 2 m x 10,000; below 4e-13 m/s under
+// 10,000 kg/m^3), and the offset tower past its buckling load leans over (54 m).
 TEST_CASE("cylinder stack sweep: stable towers stand 30 s within 1 cm and sink by their contact compliance; "
-          "aligned towers move sideways below 1e-9 m/s; towers past their buckling load lean over" *
-          doctest::should_fail()) {
+          "aligned towers move sideways below 1e-9 m/s; towers past their buckling load lean over") {
   const Real seconds = 30, g = 9.81;
   const Real k = pairStiffness(Material("default").getYoungsModulus());
   int index = 0, standing = 0, leaning = 0, total = 0, stableTotal = 0;
@@ -229,7 +230,9 @@ TEST_CASE("cylinder stack sweep: stable towers stand 30 s within 1 cm and sink b
           standing += stands;
           if (stands) worstSinkErrorStanding = std::max(worstSinkErrorStanding, sinkError);
           sinkFailures += !(sinkError < 1e-6 + 1e-6 * sink);
-          speedFailures += placement == Placement::ALIGNED && !(r.maxHorizontalSpeed < 1e-9);
+          // Aligned and stable by the closed form: symmetric, so nothing may move it (see above for the other).
+          const bool speedBound = placement == Placement::ALIGNED && stable;
+          speedFailures += speedBound && !(r.maxHorizontalSpeed < 1e-9);
           if (!stands || placement == Placement::ALIGNED || sinkError >= 1e-6 + 1e-6 * sink)
             MESSAGE(std::string(stands ? "stands: " : "falls: ")
                     << count << " x " << size << " m, " << density << " kg/m^3, mu " << mu << ", " << name(placement)
@@ -237,13 +240,13 @@ TEST_CASE("cylinder stack sweep: stable towers stand 30 s within 1 cm and sink b
                     << " m/s, sink " << r.topDrop - gaps << " m (closed form " << sink << ")");
           CHECK(r.maxHorizontalDrift < 0.01);
           CHECK(sinkError < 1e-6 + 1e-6 * sink);
-          if (placement == Placement::ALIGNED) CHECK(r.maxHorizontalSpeed < 1e-9);
+          if (speedBound) CHECK(r.maxHorizontalSpeed < 1e-9);
         }
       }
   MESSAGE(standing << " of " << stableTotal << " towers that must stand stand 30 s within 1 cm (worst drift "
                    << worstDrift << " m, worst top-sink error " << worstSinkError << " m, among those standing "
                    << worstSinkErrorStanding << " m); " << sinkFailures << " miss the sink bound, " << speedFailures
-                   << " of 27 aligned the 1e-9 m/s bound; " << leaning << " of " << total - stableTotal
+                   << " of 26 stable aligned the 1e-9 m/s bound; " << leaning << " of " << total - stableTotal
                    << " past their buckling load lean over");
   CHECK(total == 81);
 }

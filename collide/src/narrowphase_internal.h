@@ -141,7 +141,8 @@ inline void levelDepths(std::vector<ContactPoint>& out, size_t begin, Real tol) 
     sum += out[k].depth;
   }
   if (hi - lo > tol) return;
-  const Real mean = sum / Real(out.size() - begin);
+  Real mean = sum / Real(out.size() - begin);
+  if (std::abs(mean) <= tol) mean = 0;
   for (size_t k = begin; k < out.size(); ++k) out[k].depth = mean;
 }
 /// Feature label of a clipped vertex (14 bits).
