@@ -423,13 +423,12 @@ void polytopeTriangle(const Grid& g, long i, long j, int t, const Polytope& P, c
   }
 }
 
-int polytopeHeightField(Polytope& P, const Grid& g, long i0, long i1, long j0, long j1, Real margin,
-                        std::vector<ContactPoint>& out) {
-  const size_t begin = out.size();
-  thread_local std::vector<Vec3> dirs;
-  uniqueEdgeDirs(P, dirs);
-  Real zlo = std::numeric_limits<Real>::max();
-  for (const Vec3& v : P.verts) zlo = std::min(zlo, v.z());
+/// The triangles of cells [i0, i1] x [j0, j1] (rows j outer, cells i, then the cell's two triangles t) that are not
+/// wholly below the shape: f(i, j, t, vv) for each whose highest vertex is at or above zlo - margin (zlo the shape's
+/// lowest point in the field frame; a lower triangle lies below the shape by more than the margin). vv holds the
+/// triangle's grid vertices (Grid::triVerts). One loop and one cull for every shape that collides per triangle.
+template <class F>
+void forEachTriangleAbove(const Grid& g, long i0, long i1, long j0, long j1, Real zlo, Real margin, F&& f) {
   for (long j = j0; j <= j1; ++j) {
     for (long i = i0; i <= i1; ++i) {
       for (int t = 0; t < 2; ++t) {
@@ -437,11 +436,23 @@ int polytopeHeightField(Polytope& P, const Grid& g, long i0, long i1, long j0, l
         g.triVerts(i, j, t, vv);
         Real zhi = -std::numeric_limits<Real>::max();
         for (const auto& p : vv) zhi = std::max(zhi, g.hf.getHeight(size_t(p[0]), size_t(p[1])));
-        if (zhi < zlo - margin) continue;  // the whole triangle lies below the shape by more than the margin
-        polytopeTriangle(g, i, j, t, P, dirs, margin, begin, out);
+        if (zhi < zlo - margin) continue;
+        f(i, j, t, vv);
       }
     }
   }
+}
+
+int polytopeHeightField(Polytope& P, const Grid& g, long i0, long i1, long j0, long j1, Real margin,
+                        std::vector<ContactPoint>& out) {
+  const size_t begin = out.size();
+  thread_local std::vector<Vec3> dirs;
+  uniqueEdgeDirs(P, dirs);
+  Real zlo = std::numeric_limits<Real>::max();
+  for (const Vec3& v : P.verts) zlo = std::min(zlo, v.z());
+  forEachTriangleAbove(g, i0, i1, j0, j1, zlo, margin, [&](long i, long j, int t, const long(&)[3][2]) {
+    polytopeTriangle(g, i, j, t, P, dirs, margin, begin, out);
+  });
   return int(out.size() - begin);
 }
 
@@ -884,33 +895,22 @@ int collideCylinderHeightField(const Shape& s0, const Transform& t0, const Shape
   C.hh = Real(0.5) * cyl.getHeight();
   const Real zlo = cylMin(C, Vec3::UnitZ());
   const size_t begin = out.size();
-  for (long j = j0; j <= j1; ++j) {
-    for (long i = i0; i <= i1; ++i) {
-      for (int t = 0; t < 2; ++t) {
-        long vv[3][2];
-        g.triVerts(i, j, t, vv);
-        Real zhi = -std::numeric_limits<Real>::max();
-        for (const auto& p : vv) zhi = std::max(zhi, g.hf.getHeight(size_t(p[0]), size_t(p[1])));
-        if (zhi < zlo - margin) continue;
-        // Cheap cull: the cylinder's own bounding box (|x|, |z| <= r, |y| <= hh in its frame) against the
-        // triangle's vertices, one axis at a time.
-        bool apart = false;
-        for (int ax = 0; ax < 3 && !apart; ++ax) {
-          const Vec3& d = ax == 0 ? C.ex : (ax == 1 ? C.w : C.ez);
-          const Real ext = (ax == 1 ? C.hh : C.r) + margin + Real(1e-9) * (C.r + C.hh), dc = d.dot(C.c);
-          Real lo = std::numeric_limits<Real>::max(), hi = -lo;
-          for (const auto& p : vv) {
-            const Real x = d.dot(g.vert(p[0], p[1])) - dc;
-            lo = std::min(lo, x);
-            hi = std::max(hi, x);
-          }
-          apart = lo > ext || hi < -ext;
-        }
-        if (apart) continue;
-        cylinderTriangle(g, i, j, t, C, margin, begin, out);
+  forEachTriangleAbove(g, i0, i1, j0, j1, zlo, margin, [&](long i, long j, int t, const long (&vv)[3][2]) {
+    // Cheap cull: the cylinder's own bounding box (|x|, |z| <= r, |y| <= hh in its frame) against the
+    // triangle's vertices, one axis at a time.
+    for (int ax = 0; ax < 3; ++ax) {
+      const Vec3& d = ax == 0 ? C.ex : (ax == 1 ? C.w : C.ez);
+      const Real ext = (ax == 1 ? C.hh : C.r) + margin + Real(1e-9) * (C.r + C.hh), dc = d.dot(C.c);
+      Real lo = std::numeric_limits<Real>::max(), hi = -lo;
+      for (const auto& p : vv) {
+        const Real x = d.dot(g.vert(p[0], p[1])) - dc;
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
       }
+      if (lo > ext || hi < -ext) return;
     }
-  }
+    cylinderTriangle(g, i, j, t, C, margin, begin, out);
+  });
   return finish(out, begin, t1);
 }
 
