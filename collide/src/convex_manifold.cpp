@@ -15,7 +15,8 @@
 //       tolerance of perpendicular to an edge), else a vertex; capsule: its segment shifted by r along the
 //       direction when the axis is perpendicular within the tolerance, else an end point; cylinder: its cap as a
 //       regular polygon when the axis is parallel, its side line (segment) when perpendicular, else its support
-//       point; convex hull: its best-aligned face within the tolerance, else its support vertex.
+//       point; convex hull: its best-aligned face within the tolerance, else an edge at its support vertex
+//       perpendicular to the direction within the tolerance (a hull resting on an edge), else that vertex.
 //     The cap polygon's point count follows a tolerance: N is the smallest multiple of 4 whose chord sagitta
 //     r (1 - cos(pi / N)) is at most kCapSagitta r (1 %), clamped to [8, 32]; its vertices lie on the rim at
 //     fixed angles in the cylinder frame, so they are material points (stable ids, exact rim positions).
@@ -32,7 +33,9 @@
 //     feature carried there along the reference normal) the region is bounded by the other feature's vertices
 //     inside the circle, its edges' crossings with the circle, and the cap's rim points inside the other
 //     feature (they stand for the arcs). That is exact at the rim and costs O(n) instead of O(n^2) clip tests for
-//     a cap on a cap.
+//     a cap on a cap. A cap on a cap gives a band of kCapBand r about the reference circle to the reference cap,
+//     so coaxial caps (every aligned stack of equal cylinders) get the reference's rim points only, never a
+//     roundoff-chosen copy of a doubled point (the reason is at that branch).
 //  3. Reduction: at most 4 points, the deepest, then the farthest from it, then the two spanning the largest
 //     signed area on either side of that segment (reduceManifold), so the kept quadrilateral spans the contact
 //     area and the centre of pressure can sit anywhere in it.
@@ -42,8 +45,9 @@
 // segment, its end e = e; against a circle, a polygon vertex is the pair of its edges, an edge crossing the pair
 // (edge, 64 entering / 65 leaving), a rim point j the pair (64 + j, 127)). Shape feature ids: box face f = f
 // (makeBoxPolytope's order), edge 8 + 8 axis + the sign bits of the other two axes; cylinder cap 0 (-y) / 1 (+y),
-// side 2; capsule segment 1; hull face index. All are fixed in the shape's frame, so the same touching features
-// give the same ids step after step (warm starting, contact_rows.h; its position fallback covers roundoff).
+// side 2; capsule segment 1; hull face index, hull edge 0x80000000 | hash(lower, higher vertex index) >> 1. All
+// are fixed in the shape's frame, so the same touching features give the same ids step after step (warm
+// starting, contact_rows.h; its position fallback covers roundoff).
 //
 // The analytic paths stay where they are exact and faster: box-box, box-plane, capsule-capsule, capsule-box,
 // cylinder-plane, convex-convex/-box (SAT), and the cylinder cap lying on a box face (cylinder_box.cpp). Cost per
@@ -239,7 +243,47 @@ void supportFeature(const Shape& s, const Transform& t, const Vec3& d, Feature& 
         f.area = polygonArea(f);
         return;
       }
-      f.p[0] = t.apply(s.support(dl));
+      // No face: an edge when one leaving the support vertex is perpendicular to d within the tolerance (a hull
+      // resting on an edge gets the edge's two ends, as a box does), else the vertex. The edge's ends are stored
+      // lower vertex index first and its id hashes the two indices (high bit set: never a face index), so both
+      // are fixed in the hull's frame whichever end is the support vertex.
+      const auto& V = c.getVertices();
+      uint32_t iv = 0;
+      Real top = -std::numeric_limits<Real>::max();
+      for (size_t k = 0; k < V.size(); ++k) {
+        const Real x = V[k].dot(dl);
+        if (x > top) {
+          top = x;
+          iv = uint32_t(k);
+        }
+      }
+      uint32_t iw = iv;
+      Real bestSin = sinTol;
+      for (const auto& F : faces) {
+        const size_t m = F.vertices.size();
+        for (size_t k = 0; k < m; ++k) {
+          if (F.vertices[k] != iv) continue;
+          for (const uint32_t w : {F.vertices[(k + 1) % m], F.vertices[(k + m - 1) % m]}) {
+            const Vec3 e = V[w] - V[iv];
+            const Real len = e.norm();
+            if (len <= 0) continue;
+            const Real sn = std::abs(e.dot(dl)) / len;
+            if (sn <= bestSin) {
+              bestSin = sn;
+              iw = w;
+            }
+          }
+        }
+      }
+      if (iw != iv) {
+        const uint32_t lo = std::min(iv, iw), hi = std::max(iv, iw);
+        f.p[0] = t.apply(V[lo]);
+        f.p[1] = t.apply(V[hi]);
+        f.count = 2;
+        f.id = 0x80000000u | (hashFeatureIds(lo, hi) >> 1);
+        return;
+      }
+      f.p[0] = t.apply(V[iv]);
       f.count = 1;
       f.id = 0xFFFFu;
       return;

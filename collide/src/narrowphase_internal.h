@@ -132,6 +132,10 @@ inline uint32_t hashFeatureIds(uint32_t a, uint32_t b) {
 /// rotation, e.g. +-5.6e-17 m on an upright cylinder), they are set to their mean. Without it an exactly level
 /// cap placed touching got points at depth +5.6e-17 (overlap) and -5.6e-17 (a speculative gap) on opposite
 /// sides, whose rows the solver treats differently: the cylinder tipped at the first step (v 1.3e-5 m/s).
+/// A level mean within `tol` of 0 is 0 (touching: a spring row, no force until it sinks). Left at its roundoff
+/// sign, -2.8e-17 m under the 2 m cylinders of test_extremes_stacks_cylinders made every ground row a
+/// speculative stop, i.e. a rigid support that never sank: the tower's sink lacked the ground joint's compliance
+/// term exactly, and the bottom joint was rigid where every other joint is a spring.
 inline void levelDepths(std::vector<ContactPoint>& out, size_t begin, Real tol) {
   if (out.size() <= begin + 1) return;
   Real lo = out[begin].depth, hi = lo, sum = 0;
