@@ -18,6 +18,7 @@ namespace {
 
 struct PlateResult {
   Real mean = 0, min = 0, max = 0;  ///< plastic sinkage of the inner 9 x 9 vertices, m
+  std::vector<Real> vertex;          ///< each inner vertex's sinkage, row by row, m
 };
 
 /// Plate-load test on an 11 x 11 terrain (0.5 m, cells s = 0.05 m) under a bed of 121 pistons: one small sphere
@@ -54,6 +55,7 @@ PlateResult pressPlate(Real pressureOverP0, Real deformability, Real seconds, Re
     for (size_t x = 1; x < 10; ++x) {
       const Real sink = 0.5 - t->getHeightField()->getHeight(x, y);
       r.mean += sink / 81;
+      r.vertex.push_back(sink);
       r.min = std::min(r.min, sink);
       r.max = std::max(r.max, sink);
     }
@@ -97,14 +99,24 @@ TEST_SUITE("terrain") {
     MESSAGE("20 p0: sinkage " << early.mean << " m after 1.5 s, " << late.mean << " m after 3 s (D/(d+1) = " << end
                               << " m)");
     CHECK(late.min > end);
-    // Every vertex keeps sinking: the whole plate at 3 s lies 5 mm below the whole plate at 1.5 s. That needs the
-    // 121 pistons' prismatic joints solved directly (the default build). In the PGS-only build they are solved
-    // iteratively and press unevenly (measured spread 9 mm at 1.5 s, 22 mm at 3 s since the PGS block-operator
-    // change of issue 18; it passed before: an open item), so there only the mean is checked to keep sinking.
+    // Every vertex keeps sinking: each inner vertex at 3 s lies at least 5 mm below itself at 1.5 s (both runs
+    // start from the same state, so the 3 s run passes through the 1.5 s one). Measured: 10.7 mm (PGS-only build)
+    // and 13.3 mm (default build) for the least-sinking vertex, 48-52 mm for the most.
+    Real leastSink = 1e9;
+    for (size_t k = 0; k < late.vertex.size(); ++k) leastSink = std::min(leastSink, late.vertex[k] - early.vertex[k]);
+    MESSAGE("least per-vertex sinkage from 1.5 s to 3 s: " << leastSink * 1e3 << " mm");
+    CHECK(leastSink > 0.005);
+    // The whole plate at 3 s also lies 5 mm below the whole plate at 1.5 s in the default build. This compares
+    // two extremes of the plate, not one vertex over time: past D/(d+1) the plate turns into a bowl (3 s: centre
+    // 139-147 mm, edges 100-107 mm, in both builds) and at 1.5 s its vertices spread by 9-11 mm, so the margin is
+    // late.min - early.max - 5 mm = +5.1 mm (default build) and -1.0 mm (PGS-only build). That margin is noise, not
+    // a solver defect: each piston is its own problem (one sphere, its prismatic joint and the static terrain;
+    // no row couples two pistons), the iterative joints hold the pistons within 1.3 um of their axis (the direct
+    // ones within 0.11 mm), and in the PGS-only build the margin moves between -3.2 and +3.9 mm with solver
+    // settings unrelated to the soil (manifold block off or its operators assembled per visit: -1.1 / -1.0 mm;
+    // 32 sweeps -3.2 mm, 64 sweeps +3.9 mm), so the PGS-only build checks the per-vertex sinkage above.
     if (kHasDirectSolver)
       CHECK(late.min > early.max + 0.005);
-    else
-      CHECK(late.mean > early.mean + 0.005);
   }
 
   TEST_CASE("the settled plate sinkage holds at smaller time steps") {
