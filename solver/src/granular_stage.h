@@ -189,6 +189,7 @@ class GranularStage {
   /// solveUnit<kFrozen> of a centred unit (the same law, with the zero angular terms of the normal row dropped).
   template <int kFrozen>
   void solveCentred(Unit& u, Vec3* v, Vec3* w, const Real* invM, const Real* invI, Real& maxDelta) const;
+  /// Slabs from plan_ (see buildRows): slabStart_, numSlabs_, and unitDest_ (each unit's index in units_).
   void partition(const GranularBodySystem& ps, Real cellSize);
 
   std::vector<Unit> units_;          // all units: the slabs in order, then the serial set, then DIRECT mode
@@ -198,7 +199,14 @@ class GranularStage {
   std::vector<Real> invInertia_;     // [size()] 1 / (0.4 m r^2)
   std::vector<Vec3> vStart_;         // [size()] velocities at the start of the step (before applyForces)
   // Per-step buffers, kept to reuse their memory.
-  std::vector<Unit> scratchUnits_;
+  // What the partition needs of a unit (in contact order), and where the unit is built in units_.
+  struct UnitPlan {
+    uint32_t a = 0;
+    int32_t b = -1, body = -1;
+    bool direct = false;  // the contact material's solve type is not ITERATIVE (DIRECT mode)
+  };
+  std::vector<UnitPlan> plan_;
+  std::vector<uint32_t> unitDest_;
   std::vector<uint16_t> slabOf_;
   std::vector<uint32_t> slabCount_, slabCursor_;
   // Contact parameters resolved once per material pair per step.
