@@ -71,6 +71,7 @@ struct ParticleCollider::Impl {
   struct Entry {
     Vec3 x;
     Real r;
+    Real s;  // h |v| (1 + 1e-9): see the pair test
     int32_t cx, cy, cz;
     uint32_t j;
   };
@@ -198,7 +199,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
     m.entries.resize(m.sorted.size());
     for (size_t k = 0; k < m.sorted.size(); ++k) {
       const uint32_t j = m.sorted[k];
-      m.entries[k] = {x[j], r[j], m.cx[j], m.cy[j], m.cz[j], j};
+      m.entries[k] = {x[j], r[j], h * v[j].norm() * (1 + 1e-9), m.cx[j], m.cy[j], m.cz[j], j};
       if (m.dense) m.posOf[j] = uint32_t(k);
     }
   }
@@ -221,6 +222,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
       if (!ps.isAliveDense(i)) continue;
       const Vec3 xi = x[i];
       const Real ri = r[i];
+      const Real si = h * v[i].norm() * (1 + 1e-9) + margin_;
       // Position of the centre within its cell, in cells: a neighbour cell whose nearest point is at least one
       // cell (>= r_i + r_j + reach) away holds no candidate, so it is not visited (about a quarter of them).
       const Vec3 f = xi * m.invCell - Vec3(m.cx[i], m.cy[i], m.cz[i]);
@@ -238,7 +240,10 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
         const Real dist2 = d.squaredNorm();
         // Cheap reject first: beyond the largest margin (reach) the pair can never touch, and most
         // stencil candidates are that far; the relative speed (a square root) is read only for the rest.
-        const Real far = ri + e.r + reach;
+        // The bound uses h |v_i - v_j| <= h |v_i| + h |v_j|: the speeds are taken 1e-9 larger, far more than
+        // the rounding of either side, so far >= lim below in floating point too and the reject never drops a
+        // pair the exact test keeps (the contact list is the same as with the reach alone).
+        const Real far = ri + e.r + std::min(si + e.s, reach);
         if (dist2 >= far * far) return;
         const Real pairMargin = std::min(h * (v[i] - v[j]).norm() + margin_, reach);
         const Real lim = ri + e.r + pairMargin;
