@@ -34,9 +34,13 @@ constexpr int kMaxSlabs = 64;
 /// its negative). Shared by the general and the centred unit solve.
 template <class U>
 SCREE_UNIT_INLINE inline Vec3 rollingImpulse(U& u, const Vec3& wr) {
-  Real l1 = u.lR1 + (-u.t1.dot(wr) - u.eT * u.lR1) * u.kR;
-  Real l2 = u.lR2 + (-u.t2.dot(wr) - u.eT * u.lR2) * u.kR;
-  projectOntoDisc(l1, l2, u.rollMu * std::max<Real>(u.lN, 0));
+  const Real lim = u.rollMu * std::max<Real>(u.lN, 0);
+  Real l1 = 0, l2 = 0;  // a zero bound (no normal impulse: a separated or speculative contact) leaves no torque
+  if (lim != 0) {
+    l1 = u.lR1 + (-u.t1.dot(wr) - u.eT * u.lR1) * u.kR;
+    l2 = u.lR2 + (-u.t2.dot(wr) - u.eT * u.lR2) * u.kR;
+    projectOntoDisc(l1, l2, lim);
+  }
   const Vec3 T = (l1 - u.lR1) * u.t1 + (l2 - u.lR2) * u.t2;
   u.lR1 = l1;
   u.lR2 = l2;
@@ -512,10 +516,14 @@ void GranularStage::solveUnit(Unit& u, std::vector<Vec3>& v, std::vector<Vec3>& 
   }
   // Friction: scalar updates of both tangents at the same velocity, then projection onto the disc.
   if (u.mu > 0) {
-    const Vec3 vr = relVel();
-    Real l1 = u.lT1 + (u.rhsT1 - u.t1.dot(vr) - u.eT * u.lT1) * gain(u.kT1, u.t1, u.eT);
-    Real l2 = u.lT2 + (u.rhsT2 - u.t2.dot(vr) - u.eT * u.lT2) * gain(u.kT2, u.t2, u.eT);
-    projectOntoDisc(l1, l2, frictionLimit(u.mu, u.lN));
+    const Real lim = frictionLimit(u.mu, u.lN);
+    Real l1 = 0, l2 = 0;  // a zero bound projects any update to zero (as solveCentred)
+    if (lim != 0) {
+      const Vec3 vr = relVel();
+      l1 = u.lT1 + (u.rhsT1 - u.t1.dot(vr) - u.eT * u.lT1) * gain(u.kT1, u.t1, u.eT);
+      l2 = u.lT2 + (u.rhsT2 - u.t2.dot(vr) - u.eT * u.lT2) * gain(u.kT2, u.t2, u.eT);
+      projectOntoDisc(l1, l2, lim);
+    }
     const Real d1 = l1 - u.lT1, d2 = l2 - u.lT2;
     u.lT1 = l1;
     u.lT2 = l2;
@@ -569,13 +577,19 @@ void GranularStage::solveCentred(Unit& u, Vec3* v, Vec3* w, const Real* invM, co
   }
   // Friction: scalar updates of both tangents at the same velocity, then projection onto the disc.
   if (u.mu > 0) {
-    const Vec3 dv = v[a] - v[b];
-    const Vec3 L = u.la * w[a] + u.lb * w[b];
-    const Real vt1 = u.t1.dot(dv) - u.sigma * L.dot(u.t2);
-    const Real vt2 = u.t2.dot(dv) + u.sigma * L.dot(u.t1);
-    Real l1 = u.lT1 + (u.rhsT1 - vt1 - u.eT * u.lT1) * kT1;
-    Real l2 = u.lT2 + (u.rhsT2 - vt2 - u.eT * u.lT2) * kT2;
-    projectOntoDisc(l1, l2, frictionLimit(u.mu, u.lN));
+    // A zero bound (no normal impulse: a separated or speculative contact, some of the units) projects any
+    // update to zero: skip the update and the projection's square root and division.
+    const Real lim = frictionLimit(u.mu, u.lN);
+    Real l1 = 0, l2 = 0;
+    if (lim != 0) {
+      const Vec3 dv = v[a] - v[b];
+      const Vec3 L = u.la * w[a] + u.lb * w[b];
+      const Real vt1 = u.t1.dot(dv) - u.sigma * L.dot(u.t2);
+      const Real vt2 = u.t2.dot(dv) + u.sigma * L.dot(u.t1);
+      l1 = u.lT1 + (u.rhsT1 - vt1 - u.eT * u.lT1) * kT1;
+      l2 = u.lT2 + (u.rhsT2 - vt2 - u.eT * u.lT2) * kT2;
+      projectOntoDisc(l1, l2, lim);
+    }
     const Real d1 = l1 - u.lT1, d2 = l2 - u.lT2;
     u.lT1 = l1;
     u.lT2 = l2;
