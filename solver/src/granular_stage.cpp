@@ -124,8 +124,18 @@ GranularStage::PairParams GranularStage::makeParams(const SurfaceParameters& s, 
 }
 
 const GranularStage::CacheEntry* GranularStage::find(const std::vector<CacheKey>& keys,
+                                                     const std::vector<uint32_t>& first,
                                                      const std::vector<CacheEntry>& entries, uint64_t key,
                                                      uint32_t feature) {
+  if (!first.empty()) {
+    // The keys whose high half (the lower particle's slot) is key's: a few, in (key, feature, entry) order, so
+    // the first match is the one std::lower_bound finds.
+    const uint64_t hi = key >> 32;
+    if (hi + 1 >= first.size()) return nullptr;
+    for (uint32_t k = first[hi]; k < first[hi + 1]; ++k)
+      if (keys[k].key == key && keys[k].feature == feature) return &entries[keys[k].entry];
+    return nullptr;
+  }
   auto it = std::lower_bound(keys.begin(), keys.end(), CacheKey{key, feature, 0});
   if (it != keys.end() && it->key == key && it->feature == feature) return &entries[it->entry];
   return nullptr;
@@ -338,9 +348,9 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
         const uint64_t sa = slotKey(ps, a), sb = slotKey(ps, size_t(c.b));
         u.flip = sa > sb;
         sgn = u.flip ? -1.0 : 1.0;
-        ce = find(ppKeys_, ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
+        ce = find(ppKeys_, ppFirst_, ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
       } else {
-        ce = find(pgKeys_, pgCache_, slotKey(ps, a) << 32 | sides[k - pp.size()].geometryId, c.featureId);
+        ce = find(pgKeys_, pgFirst_, pgCache_, slotKey(ps, a) << 32 | sides[k - pp.size()].geometryId, c.featureId);
       }
     }
     const Real vn0 = u.n.dot(vrel);
@@ -881,21 +891,35 @@ void GranularStage::storeResults(const GranularBodySystem& ps, const ParticleCon
       pgCache_.push_back({sa << 32 | sides[u.src].geometryId, c.featureId, u.lN, F, T, u.impact});
     }
   }
-  auto index = [this](const std::vector<CacheEntry>& entries, std::vector<CacheKey>& keys) {
-    keys.resize(entries.size());
-    for (size_t e = 0; e < entries.size(); ++e) keys[e] = {entries[e].key, entries[e].feature, uint32_t(e)};
-    // In (key, feature, entry) order, as std::sort with CacheKey::operator< (the entries are pushed in
-    // increasing entry order, and the stable radix sort by feature, then key, keeps that order among equals):
-    // a third of std::sort's time here, whose comparisons were mispredicted.
-    if (keys.size() < 64) {
-      std::sort(keys.begin(), keys.end());
-      return;
-    }
-    radixSortBy(keys, keyScratch_, 32, [](const CacheKey& k) { return uint64_t(k.feature); });
-    radixSortBy(keys, keyScratch_, 64, [](const CacheKey& k) { return k.key; });
+  auto index = [this](const std::vector<CacheEntry>& entries, std::vector<CacheKey>& keys,
+                       std::vector<uint32_t>& first) {
+    indexKeys(entries, keys);
+    // first[s]: the first key whose high half is s (a slot), so find scans only that slot's few keys instead of
+    // a binary search over all (whose branches are unpredictable). Only while the slots are dense enough.
+    first.clear();
+    if (keys.empty()) return;
+    const uint64_t top = keys.back().key >> 32;
+    if (top > 4 * keys.size() + 65536) return;  // sparse slots: binary search
+    first.assign(size_t(top) + 2, 0);
+    for (const CacheKey& k : keys) ++first[size_t(k.key >> 32) + 1];
+    for (size_t s = 0; s + 1 < first.size(); ++s) first[s + 1] += first[s];
   };
-  index(ppCache_, ppKeys_);
-  index(pgCache_, pgKeys_);
+  index(ppCache_, ppKeys_, ppFirst_);
+  index(pgCache_, pgKeys_, pgFirst_);
+}
+
+void GranularStage::indexKeys(const std::vector<CacheEntry>& entries, std::vector<CacheKey>& keys) {
+  keys.resize(entries.size());
+  for (size_t e = 0; e < entries.size(); ++e) keys[e] = {entries[e].key, entries[e].feature, uint32_t(e)};
+  // In (key, feature, entry) order, as std::sort with CacheKey::operator< (the entries are pushed in
+  // increasing entry order, and the stable radix sort by feature, then key, keeps that order among equals):
+  // a third of std::sort's time here, whose comparisons were mispredicted.
+  if (keys.size() < 64) {
+    std::sort(keys.begin(), keys.end());
+    return;
+  }
+  radixSortBy(keys, keyScratch_, 32, [](const CacheKey& k) { return uint64_t(k.feature); });
+  radixSortBy(keys, keyScratch_, 64, [](const CacheKey& k) { return k.key; });
 }
 
 }  // namespace scree::detail

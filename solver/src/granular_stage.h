@@ -177,7 +177,8 @@ class GranularStage {
     }
   };
   /// The entry of (key, feature), the first in key order if there are several; null if none.
-  static const CacheEntry* find(const std::vector<CacheKey>& keys, const std::vector<CacheEntry>& entries,
+  static const CacheEntry* find(const std::vector<CacheKey>& keys, const std::vector<uint32_t>& first,
+                                const std::vector<CacheEntry>& entries,
                                 uint64_t key, uint32_t feature);
   /// One Gauss-Seidel update of unit u (normal, then friction disc, then rolling disc). kFrozen < 0: both
   /// sides move (the sweeps; |delta lambda| goes into maxDelta). kFrozen = 0 or 1: side A or B is held
@@ -226,6 +227,10 @@ class GranularStage {
   std::vector<std::pair<uint64_t, uint32_t>> shockOrder_, shockScratch_;
   std::vector<CacheEntry> ppCache_, pgCache_;
   std::vector<CacheKey> ppKeys_, pgKeys_, keyScratch_;
+  // first[s] = index of the first key whose high half (a particle slot) is s; empty: binary search (see find).
+  std::vector<uint32_t> ppFirst_, pgFirst_;
+  /// keys = (key, feature, entry) of entries in CacheKey order.
+  void indexKeys(const std::vector<CacheEntry>& entries, std::vector<CacheKey>& keys);
   // DIRECT mode, valid between appendDirectRows and finishDirect.
   size_t rowBase_ = 0, bodyBase_ = 0;  // sizes of rows / bodies before the append
   std::vector<int32_t> extBody_;       // [size()] solver body of a particle, -1 none
