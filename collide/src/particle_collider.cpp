@@ -3,6 +3,7 @@
 #include "scree/collide/particle_collider.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 
 #include "scree/collide/narrowphase.h"
@@ -23,6 +24,15 @@ constexpr size_t kChunk = 512;
 // and far more when the machine is busy (a thread that has to wait for its descheduled peer). The chunks and
 // their merge order are the same either way, so the results do not change.
 constexpr size_t kParallelChunks = 4;
+// The dense grid is used while the live cells' padded bounding box has at most this many cells per particle
+// (plus 4096): its cell-start array is then a few times the particle arrays at most.
+constexpr size_t kDenseCellsPerParticle = 8;
+
+#if defined(__GNUC__)
+#define SCREE_PAIR_INLINE __attribute__((always_inline))
+#else
+#define SCREE_PAIR_INLINE
+#endif
 
 // Cell coordinate of a position component; clamped so that a particle far away (1e9 cells) cannot overflow
 // the integer conversion (it only shares a cell with other far-away particles).
@@ -60,6 +70,8 @@ struct ParticleCollider::Impl {
   // contiguously (no indirection into the particle arrays for the candidates that are rejected).
   struct Entry {
     Vec3 x;
+    Real r;
+    Real s;  // h |v| (1 + 1e-9): see the pair test
     int32_t cx, cy, cz;
     uint32_t j;
   };
@@ -73,9 +85,27 @@ struct ParticleCollider::Impl {
   std::vector<std::unique_ptr<Geometry>> probes;
   std::vector<std::vector<ContactPoint>> scratch;
   std::vector<uint32_t> candidates;
+  // ---- dense grid (see "Dense grid" in collide()) ----
+  // When the live particles' cells span a box of at most kDenseCellsPerParticle cells per particle, the
+  // buckets are the box's cells themselves (no hash, no collisions): bucketOf is the cell's index in (z, y, x)
+  // order with one empty padding cell on each side in x and y and one layer on top in z, so the cells of the
+  // half stencil are 5 contiguous runs (own row, row y+1, and the three rows of layer z+1).
+  bool dense = false;
+  int32_t lo[3] = {0, 0, 0}, hi[3] = {-1, -1, -1};  // live cells' bounds (cell coordinates)
+  int64_t nx = 0, nxy = 0;                          // padded row length and layer size
+  std::vector<uint32_t> posOf;                      // [size()] index of a particle in sorted (dense grid only)
 
+  int64_t denseCell(int64_t x, int64_t y, int64_t z) const {
+    return ((z - lo[2]) * (nxy / nx) + (y - lo[1] + 1)) * nx + (x - lo[0] + 1);
+  }
   template <class F>
   void forCell(int64_t x, int64_t y, int64_t z, F&& f) const {
+    if (dense) {
+      if (x < lo[0] || x > hi[0] || y < lo[1] || y > hi[1] || z < lo[2] || z > hi[2]) return;
+      const size_t c = size_t(denseCell(x, y, z));
+      for (uint32_t k = bucketStart[c]; k < bucketStart[c + 1]; ++k) f(sorted[k]);
+      return;
+    }
     const size_t b = hashCell(x, y, z) & tableMask;
     for (uint32_t k = bucketStart[b]; k < bucketStart[b + 1]; ++k) {
       const uint32_t j = sorted[k];
@@ -108,9 +138,6 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
   const Real reach = std::min(2 * maxV * h + margin_, 2 * maxR);
   m.cell = 2 * maxR + reach;
   m.invCell = 1.0 / m.cell;
-  size_t table = 64;
-  while (table < 2 * n) table <<= 1;
-  m.tableMask = table - 1;
   m.cx.resize(n);
   m.cy.resize(n);
   m.cz.resize(n);
@@ -120,7 +147,44 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
     m.cx[i] = cellCoord(x[i].x(), m.invCell);
     m.cy[i] = cellCoord(x[i].y(), m.invCell);
     m.cz[i] = cellCoord(x[i].z(), m.invCell);
-    m.bucketOf[i] = uint32_t(hashCell(m.cx[i], m.cy[i], m.cz[i]) & m.tableMask);
+  }
+  // Dense grid: the live cells' bounding box, padded, when it is small enough (a particle flung far away makes
+  // it large: then the hashed grid). Both give the same contact list (the pairs are sorted below).
+  m.lo[0] = m.lo[1] = m.lo[2] = INT32_MAX;
+  m.hi[0] = m.hi[1] = m.hi[2] = INT32_MIN;
+  for (size_t i = 0; i < n; ++i) {
+    if (!ps.isAliveDense(i)) continue;
+    m.lo[0] = std::min(m.lo[0], m.cx[i]);
+    m.hi[0] = std::max(m.hi[0], m.cx[i]);
+    m.lo[1] = std::min(m.lo[1], m.cy[i]);
+    m.hi[1] = std::max(m.hi[1], m.cy[i]);
+    m.lo[2] = std::min(m.lo[2], m.cz[i]);
+    m.hi[2] = std::max(m.hi[2], m.cz[i]);
+  }
+  size_t table = 64;
+  m.dense = false;
+  if (m.lo[0] <= m.hi[0]) {
+    const int64_t ex = int64_t(m.hi[0]) - m.lo[0] + 3, ey = int64_t(m.hi[1]) - m.lo[1] + 3,
+                  ez = int64_t(m.hi[2]) - m.lo[2] + 2;
+    // Checked factor by factor: each extent is below 2e9 + 3, so no product below overflows int64.
+    const int64_t limit = int64_t(kDenseCellsPerParticle * n) + 4096;
+    if (ex <= limit && ey <= limit && ez <= limit && ex * ey <= limit && ex * ey * ez <= limit) {
+      m.dense = true;
+      m.nx = ex;
+      m.nxy = ex * ey;
+      table = size_t(ex * ey * ez);
+    }
+  }
+  if (m.dense) {
+#pragma omp parallel for schedule(static) if (n >= kParallelChunks * kChunk)
+    for (size_t i = 0; i < n; ++i)
+      m.bucketOf[i] = ps.isAliveDense(i) ? uint32_t(m.denseCell(m.cx[i], m.cy[i], m.cz[i])) : 0;
+    m.posOf.resize(n);
+  } else {
+    while (table < 2 * n) table <<= 1;
+    m.tableMask = table - 1;
+#pragma omp parallel for schedule(static) if (n >= kParallelChunks * kChunk)
+    for (size_t i = 0; i < n; ++i) m.bucketOf[i] = uint32_t(hashCell(m.cx[i], m.cy[i], m.cz[i]) & m.tableMask);
   }
   m.bucketStart.assign(table + 1, 0);
   for (size_t i = 0; i < n; ++i)
@@ -135,7 +199,8 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
     m.entries.resize(m.sorted.size());
     for (size_t k = 0; k < m.sorted.size(); ++k) {
       const uint32_t j = m.sorted[k];
-      m.entries[k] = {x[j], m.cx[j], m.cy[j], m.cz[j], j};
+      m.entries[k] = {x[j], r[j], h * v[j].norm() * (1 + 1e-9), m.cx[j], m.cy[j], m.cz[j], j};
+      if (m.dense) m.posOf[j] = uint32_t(k);
     }
   }
 
@@ -157,6 +222,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
       if (!ps.isAliveDense(i)) continue;
       const Vec3 xi = x[i];
       const Real ri = r[i];
+      const Real si = h * v[i].norm() * (1 + 1e-9) + margin_;
       // Position of the centre within its cell, in cells: a neighbour cell whose nearest point is at least one
       // cell (>= r_i + r_j + reach) away holds no candidate, so it is not visited (about a quarter of them).
       const Vec3 f = xi * m.invCell - Vec3(m.cx[i], m.cy[i], m.cz[i]);
@@ -167,6 +233,41 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
         gap2[ax][1] = 0;
         gap2[ax][2] = hi * hi;
       }
+      // A candidate j at entry e: the same tests whichever grid found it.
+      auto test = [&](const Impl::Entry& e) SCREE_PAIR_INLINE {
+        const uint32_t j = e.j;
+        const Vec3 d = xi - e.x;  // the negative of x_j - x_i: the same squared norm
+        const Real dist2 = d.squaredNorm();
+        // Cheap reject first: beyond the largest margin (reach) the pair can never touch, and most
+        // stencil candidates are that far; the relative speed (a square root) is read only for the rest.
+        // The bound uses h |v_i - v_j| <= h |v_i| + h |v_j|: the speeds are taken 1e-9 larger, far more than
+        // the rounding of either side, so far >= lim below in floating point too and the reject never drops a
+        // pair the exact test keeps (the contact list is the same as with the reach alone).
+        const Real far = ri + e.r + std::min(si + e.s, reach);
+        if (dist2 >= far * far) return;
+        const Real pairMargin = std::min(h * (v[i] - v[j]).norm() + margin_, reach);
+        const Real lim = ri + e.r + pairMargin;
+        if (dist2 >= lim * lim) return;
+        out.push_back(j > i ? std::make_pair(uint32_t(i), j) : std::make_pair(j, uint32_t(i)));
+      };
+      if (m.dense) {
+        // Dense grid: the own cell after i's entry (the partners of higher index: a cell's entries are in
+        // dense order) and, when in reach, the cell x+1 of the same row; then the rows (y+1, z) and
+        // (y-1..y+1, z+1), each from x-1 to x+1 trimmed by the same one-cell rule. A row is one contiguous run.
+        const int64_t c = int64_t(m.bucketOf[i]);
+        const uint32_t own1 = m.bucketStart[size_t(c) + (gap2[0][2] < 1 ? 2 : 1)];
+        for (uint32_t k = m.posOf[i] + 1; k < own1; ++k) test(m.entries[k]);
+        for (int dz = 0; dz <= 1; ++dz)
+          for (int dy = dz == 0 ? 1 : -1; dy <= 1; ++dy) {
+            const Real g = gap2[1][dy + 1] + gap2[2][dz + 1];
+            if (g >= 1) continue;
+            const int64_t row = c + dz * m.nxy + dy * m.nx;
+            const uint32_t k0 = m.bucketStart[size_t(row + (g + gap2[0][0] < 1 ? -1 : 0))];
+            const uint32_t k1 = m.bucketStart[size_t(row + (g + gap2[0][2] < 1 ? 2 : 1))];
+            for (uint32_t k = k0; k < k1; ++k) test(m.entries[k]);
+          }
+        continue;
+      }
       for (int dz = 0; dz <= 1; ++dz)
         for (int dy = dz == 0 ? 0 : -1; dy <= 1; ++dy)
           for (int dx = dz == 0 && dy == 0 ? 0 : -1; dx <= 1; ++dx) {
@@ -176,18 +277,8 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
             const size_t b = hashCell(qx, qy, qz) & m.tableMask;
             for (uint32_t k = m.bucketStart[b]; k < m.bucketStart[b + 1]; ++k) {
               const Impl::Entry& e = m.entries[k];
-              const uint32_t j = e.j;
-              if ((own && j <= i) || e.cx != qx || e.cy != qy || e.cz != qz) continue;
-              const Vec3 d = xi - e.x;  // the negative of x_j - x_i: the same squared norm
-              const Real dist2 = d.squaredNorm();
-              // Cheap reject first: beyond the largest margin (reach) the pair can never touch, and most
-              // stencil candidates are that far; the relative speed (a square root) is read only for the rest.
-              const Real far = ri + r[j] + reach;
-              if (dist2 >= far * far) continue;
-              const Real pairMargin = std::min(h * (v[i] - v[j]).norm() + margin_, reach);
-              const Real lim = ri + r[j] + pairMargin;
-              if (dist2 >= lim * lim) continue;
-              out.push_back(j > i ? std::make_pair(uint32_t(i), j) : std::make_pair(j, uint32_t(i)));
+              if ((own && e.j <= i) || e.cx != qx || e.cy != qy || e.cz != qz) continue;
+              test(e);
             }
           }
     }

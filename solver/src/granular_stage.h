@@ -177,7 +177,8 @@ class GranularStage {
     }
   };
   /// The entry of (key, feature), the first in key order if there are several; null if none.
-  static const CacheEntry* find(const std::vector<CacheKey>& keys, const std::vector<CacheEntry>& entries,
+  static const CacheEntry* find(const std::vector<CacheKey>& keys, const std::vector<uint32_t>& first,
+                                const std::vector<CacheEntry>& entries,
                                 uint64_t key, uint32_t feature);
   /// One Gauss-Seidel update of unit u (normal, then friction disc, then rolling disc). kFrozen < 0: both
   /// sides move (the sweeps; |delta lambda| goes into maxDelta). kFrozen = 0 or 1: side A or B is held
@@ -189,6 +190,7 @@ class GranularStage {
   /// solveUnit<kFrozen> of a centred unit (the same law, with the zero angular terms of the normal row dropped).
   template <int kFrozen>
   void solveCentred(Unit& u, Vec3* v, Vec3* w, const Real* invM, const Real* invI, Real& maxDelta) const;
+  /// Slabs from plan_ (see buildRows): slabStart_, numSlabs_, and unitDest_ (each unit's index in units_).
   void partition(const GranularBodySystem& ps, Real cellSize);
 
   std::vector<Unit> units_;          // all units: the slabs in order, then the serial set, then DIRECT mode
@@ -198,7 +200,14 @@ class GranularStage {
   std::vector<Real> invInertia_;     // [size()] 1 / (0.4 m r^2)
   std::vector<Vec3> vStart_;         // [size()] velocities at the start of the step (before applyForces)
   // Per-step buffers, kept to reuse their memory.
-  std::vector<Unit> scratchUnits_;
+  // What the partition needs of a unit (in contact order), and where the unit is built in units_.
+  struct UnitPlan {
+    uint32_t a = 0;
+    int32_t b = -1, body = -1;
+    bool direct = false;  // the contact material's solve type is not ITERATIVE (DIRECT mode)
+  };
+  std::vector<UnitPlan> plan_;
+  std::vector<uint32_t> unitDest_;
   std::vector<uint16_t> slabOf_;
   std::vector<uint32_t> slabCount_, slabCursor_;
   // Contact parameters resolved once per material pair per step.
@@ -218,6 +227,10 @@ class GranularStage {
   std::vector<std::pair<uint64_t, uint32_t>> shockOrder_, shockScratch_;
   std::vector<CacheEntry> ppCache_, pgCache_;
   std::vector<CacheKey> ppKeys_, pgKeys_, keyScratch_;
+  // first[s] = index of the first key whose high half (a particle slot) is s; empty: binary search (see find).
+  std::vector<uint32_t> ppFirst_, pgFirst_;
+  /// keys = (key, feature, entry) of entries in CacheKey order.
+  void indexKeys(const std::vector<CacheEntry>& entries, std::vector<CacheKey>& keys);
   // DIRECT mode, valid between appendDirectRows and finishDirect.
   size_t rowBase_ = 0, bodyBase_ = 0;  // sizes of rows / bodies before the append
   std::vector<int32_t> extBody_;       // [size()] solver body of a particle, -1 none

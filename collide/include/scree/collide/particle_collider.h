@@ -10,6 +10,12 @@
 // so the contact list is the same for any number of threads. A stencil cell whose nearest point is at least one
 // cell away from the particle is skipped (no pair can reach it), and each bucket is scanned in a contiguous copy
 // of its particles' cells and centres.
+// Dense grid: while the live particles' cells span a box of at most 8 cells per particle, the buckets are
+// that box's cells (padded by one, in z, y, x order) instead of hash buckets: no collisions and no cell test
+// per candidate, and the 14 cells of the half stencil become 5 contiguous runs of the copy (the own cell from
+// the particle's own entry on, plus x+1; the rows y+1 of its layer and y-1..y+1 of the layer above, x-1..x+1).
+// A particle flung far away falls back to the hashed grid. Both find the same pairs, which are then sorted,
+// so the contact list is identical either way.
 //
 // Particle pairs: analytic sphere-sphere. A pair is a (speculative) contact when its gap is below
 //   margin_ab = h |v_a - v_b| + contactMargin,
