@@ -5,11 +5,12 @@
 // depths, two widths and two rake angles (bench/scenes/terrain_fee.h; docs/terrain.md, "Digging force against the
 // fundamental earthmoving equation").
 //
-//   build/examples/terrain_fee_study [DIR [TRAVEL [WEDGE]]]   prints the table; with DIR writes DIR/fee.dat (one line per
+//   build/examples/terrain_fee_study [DIR [TRAVEL [WEDGE [PHASES]]]]   prints the table; with DIR writes DIR/fee.dat (one line per
 //   setting: rake_deg depth width force fee fee_surcharge soil_volume force0 pile_slope) and DIR/fee_series.dat (travel, horizontal
 //   and vertical force, heap top, particles and the force's 10-step running mean of every step of every setting, blocks separated by two blank lines);
 //   docs/terrain/fee.gp plots them. TRAVEL (m, default 0.3) changes the push length; WEDGE 0 turns the cut's
-//   failure wedge off (Terrain::setShovelFailureWedge). F0 and k_s: the line F(s) = F0 + k_s s through the force
+//   failure wedge off (Terrain::setShovelFailureWedge); PHASES (default 4) start positions
+//   within one cell are averaged (runTerrainFeeAveraged; the series too). F0 and k_s: the line F(s) = F0 + k_s s through the force
 //   at travel s > 0.05 m (TerrainFeeResult::force0, pileSlope).
 //
 // FEE+q: the FEE with the surcharge q = gamma V / (w L), V the soil the particles carry (mean over the window),
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
   TerrainFeeParams base;
   if (argc > 2) base.travel = std::atof(argv[2]);
   if (argc > 3) base.failureWedge = std::atoi(argv[3]) != 0;  // 0: the cut without the failure wedge
+  const int phases = argc > 4 ? std::atoi(argv[4]) : 4;           // start positions averaged (runTerrainFeeAveraged)
   const Real phi = std::atan(base.soilFriction), delta = std::atan(base.bladeFriction);
   std::printf("phi = %.2f deg, delta = %.2f deg, gamma = %.0f N/m^3\n", phi * 180 / M_PI, delta * 180 / M_PI,
               base.density * g);
@@ -54,7 +56,7 @@ int main(int argc, char** argv) {
         p.depth = d;
         p.width = w;
         const auto t0 = std::chrono::steady_clock::now();
-        const TerrainFeeResult r = runTerrainFee(p);
+        const TerrainFeeResult r = runTerrainFeeAveraged(p, phases);
         const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const Real gamma = p.density * g;
         const Real fee = feeHorizontalForce(p.rake, phi, delta, gamma, d, w);

@@ -7,7 +7,9 @@
 // Two measures of the horizontal force are compared with the FEE's gamma d^2 w N_gamma sin(alpha + delta): the
 // mean over the second half of the push (wedge + the dug soil pushed so far, the FEE's surcharge term) and F0, the
 // force extrapolated to zero travel from the least-squares line F(s) = F0 + k_s s (the wedge term alone; k_s s is
-// the pile's, reported in the messages).
+// the pile's, reported in the messages). Each setting is pushed from 4 start positions spread over one height-field
+// cell and the results averaged (runTerrainFeeAveraged: the lattice's pulses, not the cut, otherwise decide F0).
+// 48 pushes, about 50 s of CPU in Release on one thread.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -27,6 +29,7 @@ constexpr Real kPi = 3.14159265358979323846;
 constexpr Real kRakes[2] = {45, 60};
 constexpr Real kDepths[3] = {0.03, 0.05, 0.07};
 constexpr Real kWidths[2] = {0.2, 0.3};
+constexpr int kPhases = 4;  // start positions averaged per setting (runTerrainFeeAveraged)
 
 struct Study {
   Real force[2][2][3] = {};  // [rake][width][depth], N
@@ -49,16 +52,25 @@ const Study& study() {
           p.rake = kRakes[a] * kPi / 180;
           p.width = kWidths[k];
           p.depth = kDepths[j];
-          const TerrainFeeResult r = runTerrainFee(p);
+          const TerrainFeeResult r = runTerrainFeeAveraged(p, kPhases);
           out.force[a][k][j] = r.meanForce;
           out.force0[a][k][j] = r.force0;
           out.slope[a][k][j] = r.pileSlope;
           out.fee[a][k][j] = feeHorizontalForce(p.rake, phi, delta, p.density * 9.81, p.depth, p.width);
           out.worstLedger = std::max(out.worstLedger, r.ledgerDrift);
+          // The soil-blade friction the push mobilises: the blade's force, normal N and friction mu' N up its face,
+          // has V / H = (cos alpha - mu' sin alpha) / (sin alpha + mu' cos alpha) (V downward on the blade), over
+          // the whole push after the first 2 cm. The FEE assumes mu' = tan(delta) = 0.364 (20 deg).
+          Real sumH = 0, sumV = 0;
+          for (const TerrainFeeSample& x : r.samples)
+            if (x.travel > 0.02) sumH += x.force, sumV += -x.vertical;
+          const Real vh = sumV / sumH, ca = std::cos(p.rake), sa = std::sin(p.rake);
+          const Real deltaEff = std::atan((ca - vh * sa) / (sa + vh * ca)) * 180 / kPi;
           MESSAGE("rake " << kRakes[a] << " deg, w " << kWidths[k] << " m, d " << kDepths[j] << " m: F = "
                           << r.meanForce << " N, FEE = " << out.fee[a][k][j] << " N, ratio "
                           << r.meanForce / out.fee[a][k][j] << "; F0 = " << r.force0 << " N (F0 / FEE "
-                          << r.force0 / out.fee[a][k][j] << "), k_s = " << r.pileSlope << " N/m");
+                          << r.force0 / out.fee[a][k][j] << "), k_s = " << r.pileSlope << " N/m; V / H = " << vh
+                          << ", mobilised blade friction angle " << deltaEff << " deg");
         }
     setNumThreads(0);
     return out;
@@ -123,7 +135,7 @@ TEST_CASE("FEE digging-force study: force proportional to width, within a factor
       CHECK_MESSAGE(ratio >= 0.5, "rake " << kRakes[a] << ", w " << kWidths[k] << ": F / FEE = " << ratio);
       CHECK_MESSAGE(ratio <= 2.0, "rake " << kRakes[a] << ", w " << kWidths[k] << ": F / FEE = " << ratio);
       // The wedge term alone, F0 (zero travel: no dug soil pushed yet), within the same factor 2 of the FEE
-      // without surcharge. Measured 0.61-0.74 (docs/terrain.md); without the failure wedge it was 0.02-0.25 at
+      // without surcharge. Measured 0.62-0.83 (4 start positions averaged, docs/terrain.md); without the failure wedge it was 0.02-0.25 at
       // this depth (the cut cleared the ground ahead at no cost), so this fails if the wedge is not taken.
       const Real r0 = s.force0[a][k][1] / s.fee[a][k][1];
       CHECK_MESSAGE(r0 >= 0.5, "rake " << kRakes[a] << ", w " << kWidths[k] << ": F0 / FEE = " << r0);
@@ -134,9 +146,15 @@ TEST_CASE("FEE digging-force study: force proportional to width, within a factor
 
 // The issue's bound on the depth exponent, applied to the wedge term F0 (docs/terrain.md, "The failure wedge":
 // the window mean also holds the pile of dug soil, the FEE's surcharge term, linear in d, so its exponent is not
-// the FEE's d^2 one; it is printed too). Does not hold at 60 degrees: F0's exponents 2.06, 1.88 (45 degrees) and
-// 1.50, 1.40 (60 degrees). Skipped, not loosened: run it with --no-skip to see the fitted exponents.
-TEST_CASE("FEE digging-force study: fitted exponent of d is 2 +- 0.4" * doctest::skip()) {
+// the FEE's d^2 one; it is printed too). F0 is the mean over kPhases start positions within one cell
+// (runTerrainFeeAveraged): one push's F0 moves by up to +-1.5 N with a 5 mm shift of the start (the force comes
+// in pulses as batches of particles are made), which moved one series' exponent by +-0.6 (45 degrees, w 0.2 m:
+// 1.6-2.9 over four starts). Measured with the phases averaged: 2.12, 1.92 (45 degrees), 1.68, 1.62 (60 degrees;
+// 1.71, 1.63 with 8 phases). The 60 degree series sit near the bound's edge: F0 / FEE falls with d there (0.83,
+// 0.70, 0.63 at w 0.2 m) because the blade's friction is less mobilised in deeper cuts (the force's
+// vertical-to-horizontal ratio gives an effective soil-blade friction angle of 6-8 degrees at 3 cm, 3-4 at 5
+// and 7 cm, against 9-11 at 45 degrees; FEE assumes the full 20), docs/terrain.md.
+TEST_CASE("FEE digging-force study: fitted exponent of d is 2 +- 0.4") {
   const Study& s = study();
   for (int a = 0; a < 2; ++a)
     for (int k = 0; k < 2; ++k) {

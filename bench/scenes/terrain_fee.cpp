@@ -95,7 +95,7 @@ TerrainFeeResult runTerrainFee(const TerrainFeeParams& p) {
   body->add(blade);
   body->setMotionControl(RigidBody::KINEMATICS);
   const Quat q(Eigen::AngleAxis<Real>(p.rake, Vec3::UnitY()));
-  const Vec3 tip0(-0.7, 0, -p.depth);
+  const Vec3 tip0(p.start, 0, -p.depth);
   body->setRotation(q);
   body->setPosition(tip0 - q * Vec3(0.5 * p.bladeLength, 0, 0));
   s.sim->add(body);
@@ -146,6 +146,37 @@ TerrainFeeResult runTerrainFee(const TerrainFeeParams& p) {
       out.pileSlope = sxx > 0 ? sxy / sxx : 0;
       out.force0 = mf - out.pileSlope * ms;
     }
+  }
+  return out;
+}
+
+TerrainFeeResult runTerrainFeeAveraged(const TerrainFeeParams& p, int phases) {
+  if (phases < 1) phases = 1;
+  TerrainFeeResult out;
+  for (int k = 0; k < phases; ++k) {
+    TerrainFeeParams q = p;
+    q.start = p.start + p.cell * Real(k) / Real(phases);
+    const TerrainFeeResult r = runTerrainFee(q);
+    if (k == 0) {
+      out.samples = r.samples;
+    } else {
+      for (size_t i = 0; i < out.samples.size() && i < r.samples.size(); ++i) {
+        TerrainFeeSample& a = out.samples[i];
+        const TerrainFeeSample& b = r.samples[i];
+        a.force += b.force, a.vertical += b.vertical, a.heapHeight += b.heapHeight, a.soilVolume += b.soilVolume;
+        a.particles += b.particles;
+      }
+    }
+    out.meanForce += r.meanForce / phases;
+    out.meanHeapHeight += r.meanHeapHeight / phases;
+    out.meanSoilVolume += r.meanSoilVolume / phases;
+    out.force0 += r.force0 / phases;
+    out.pileSlope += r.pileSlope / phases;
+    out.ledgerDrift = std::max(out.ledgerDrift, r.ledgerDrift);
+  }
+  for (TerrainFeeSample& a : out.samples) {
+    a.force /= phases, a.vertical /= phases, a.heapHeight /= phases, a.soilVolume /= phases;
+    a.particles = size_t(std::lround(Real(a.particles) / phases));
   }
   return out;
 }

@@ -38,6 +38,7 @@ struct TerrainFeeParams {
   Real bladeThickness = 0.002; ///< m (thin: a blunt edge presses particles smaller than it into the floor)
   Real speed = 0.2;           ///< m/s along +x
   Real travel = 0.3;          ///< m pushed
+  Real start = -0.7;          ///< x of the cutting edge at t = 0, m (the field spans x in [-1, 1])
   Real cell = 0.02;           ///< height-field cell, m
   Real radius = 0.01;         ///< particle radius, m
   Real density = 1600;        ///< bulk density, kg/m^3
@@ -73,5 +74,13 @@ struct TerrainFeeResult {
 };
 
 TerrainFeeResult runTerrainFee(const TerrainFeeParams& p);
+
+/// runTerrainFee at `phases` start positions p.start + k p.cell / phases (k = 0 .. phases - 1), spread over one
+/// height-field cell, with every scalar and every step's sample averaged (ledgerDrift: the largest). Why: where
+/// the edge starts relative to the grid and the particle lattice decides when each batch of particles is made,
+/// and the force comes in pulses with it; one push's F0 (the line's intercept) moved by up to +-1.5 N (a factor
+/// 2.7 at d = 3 cm) with a 5 mm shift of the start, enough to move one rake's fitted exponent of d by +-0.6
+/// (docs/terrain.md, "The failure wedge"). The mean over the phases is the force of the cut, not of its lattice.
+TerrainFeeResult runTerrainFeeAveraged(const TerrainFeeParams& p, int phases);
 
 }  // namespace scree::scenes

@@ -274,6 +274,7 @@ void Terrain::cut(const Shovel& s) {
   TerrainDataInterface& di = *data_;
   const Real M = di.maxMultiplier_, D = di.depthForMax_;
   const Vec3& n = s.upL;
+  Real groundTop = -std::numeric_limits<Real>::infinity();  // highest footprint vertex before the cut (the wedge's cap)
   for (long long j = j0; j <= j1; ++j)
     for (long long i = i0; i <= i1; ++i) {
       if (lockedBorders_ && isBorderVertex(size_t(i), size_t(j))) continue;
@@ -285,6 +286,7 @@ void Terrain::cut(const Shovel& s) {
         if (xi > lead) floor = std::max(floor, s.boxLowL + (xi - lead) * tanBeta);
       }
       const Real h = heightField_->getHeight(size_t(i), size_t(j));
+      groundTop = std::max(groundTop, h);
       if (!(h > floor)) continue;
       const Real dz = h - floor;
       const size_t v = size_t(j) * nx_ + size_t(i);
@@ -303,7 +305,24 @@ void Terrain::cut(const Shovel& s) {
       }
     }
   const Real rect[4] = {loX, hiX, loY, hiY};
-  createParticles(s, size_t(i0), size_t(i1), size_t(j0), size_t(j1), wedge ? rect : nullptr);
+  if (!wedge) {
+    createParticles(s, size_t(i0), size_t(i1), size_t(j0), size_t(j1), nullptr);
+    return;
+  }
+  // The wedge's cap (terrain.h, "The failure wedge"): sites over the wedge may stand where its soil stood. The
+  // soil farthest from the shovel plane is the wedge's far top edge, where the failure plane meets the ground:
+  // at height min(groundTop, box top) and xi = lead + (that height - box bottom) / tan(beta*) ahead of the edge.
+  // A bare blade's cap (its box's top corner along up) is shorter than that for a steep rake and a deep cut
+  // (60 degrees, d = 7 cm: 0.16 against 0.18 m), and the wedge's far soil then stayed pending: the blade never met
+  // it (docs/terrain.md, "The failure wedge").
+  Shovel sw = s;
+  if (std::isfinite(groundTop) && tanBeta > 0) {
+    const Real zTop = std::min(groundTop, s.boxLowL + reach * tanBeta);
+    const Real xiTop = lead + std::max<Real>(0, zTop - s.boxLowL) / tanBeta;
+    const Vec3 far(s.tipL.x() + ex * xiTop, s.tipL.y() + ey * xiTop, zTop);
+    sw.cap = std::max(s.cap, (far - (s.tipL + s.upL * s.thickness)).dot(s.upL));
+  }
+  createParticles(sw, size_t(i0), size_t(i1), size_t(j0), size_t(j1), rect);
 }
 
 Real Terrain::failureWedgeAngle(Real rake, Real phi, Real delta) {

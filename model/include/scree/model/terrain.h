@@ -300,7 +300,10 @@
 // lead's front, in the horizontal direction from the box's centre to the tip, up to the height of the box's top;
 // across it, the footprint's (axis-aligned) extent as for the lead. The soil it takes goes heightField -> pending
 // as any cut, and particles are made over the whole cut (box, lead and wedge: sites lie over that rectangle, not
-// only over the box). Why: the manual cuts "the volume above the cutting surface inside the footprint", and
+// only over the box); the cap (below) reaches at least the wedge's far top edge (where the failure plane meets
+// the ground), so the wedge's sites may stand where its soil stood - a bare blade's cap (its box's top corner
+// along up) fell short of that at a steep rake and a deep cut (60 degrees, 7 cm: 0.16 m against 0.18 m) and the
+// far part of the wedge stayed pending, soil the blade never met. Why: the manual cuts "the volume above the cutting surface inside the footprint", and
 // with a rigid height field ahead of the edge nothing fails in front of a blade: a blade then pushes only what it
 // has already cut, a force that grows with travel and linearly with depth (the FEE's surcharge term), and the
 // FEE's gamma d^2 w N_gamma - the weight and shear of the wedge - is missing (docs/terrain.md measured it at 0.02-
