@@ -15,8 +15,12 @@
 //    as before, now to a relative tolerance of 1e-7 (kShockTolerance).
 //  - Sweep order: rows stay in contact-list order, which on the reference stacks is already bottom-up (sorting the
 //    couplings by support level changed no figure; top-down made pyramid20 without the shock pass 5.7 m worse).
+//  - The visit multiplies by the block's precomputed inverse (PgsBlocks::Block::sInv) instead of two triangular
+//    solves: their six dependent divisions were the largest single cost of a visit.
+//  - Scheduling: the default sweep is serial in row order; Solver::setUseColouredSweeps selects graph-coloured
+//    sweeps shared among threads with bit-identical results (end of this file, pgs.h PgsColouring).
 //  - Not done: the base sweeps alone still do not hold pyramid20 (shock pass off: 49 cm at 10 iterations,
-//    over-relaxing the blocks made it worse), and the sweeps are serial.
+//    over-relaxing the blocks made it worse).
 #include "scree/solver/pgs.h"
 
 #include <algorithm>
