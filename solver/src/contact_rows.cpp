@@ -152,6 +152,8 @@ void buildContactRows(SimulationState& s) {
 
     const int32_t firstNormal = nextNormal;
     uint32_t activeIndex = 0;
+    const auto warmRange = warm ? s.warmStart.pairRange(pair) : std::pair<const WarmStartCache::Entry*,
+                                                                          const WarmStartCache::Entry*>{};
     Vec3 warmFriction = zero;  // manifold friction: sum of the points' cached friction impulses
     Real warmTwist = 0;        // and their moment about the centre along the normal
     for (uint32_t pi = 0; pi < pts.size(); ++pi) {
@@ -161,7 +163,7 @@ void buildContactRows(SimulationState& s) {
       const uint32_t ak = activeIndex++;
       const Vec3& n = p.normal;
       const Vec3 ra = p.point - xa, rb = p.point - xb;
-      const WarmStartCache::Entry* ce = warm ? s.warmStart.find(pair, p.featureId, p.point) : nullptr;
+      const WarmStartCache::Entry* ce = warm ? WarmStartCache::find(warmRange, p.featureId, p.point) : nullptr;
       if (ce) ++numWarm;
 
       // --- normal row (contact_law.h) ---

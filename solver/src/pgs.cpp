@@ -15,11 +15,16 @@
 //    as before, now to a relative tolerance of 1e-7 (kShockTolerance).
 //  - Sweep order: rows stay in contact-list order, which on the reference stacks is already bottom-up (sorting the
 //    couplings by support level changed no figure; top-down made pyramid20 without the shock pass 5.7 m worse).
+//  - The visit multiplies by the block's precomputed inverse (PgsBlocks::Block::sInv) instead of two triangular
+//    solves: their six dependent divisions were the largest single cost of a visit.
+//  - Scheduling: the default sweep is serial in row order; Solver::setUseColouredSweeps selects graph-coloured
+//    sweeps shared among threads with bit-identical results (end of this file, pgs.h PgsColouring).
 //  - Not done: the base sweeps alone still do not hold pyramid20 (shock pass off: 49 cm at 10 iterations,
-//    over-relaxing the blocks made it worse), and the sweeps are serial.
+//    over-relaxing the blocks made it worse).
 #include "scree/solver/pgs.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "contact_law.h"
@@ -205,7 +210,7 @@ static void buildBlock(const ConstraintRow* R, PgsBlocks::Block& B) {
         for (int c = 0; c < 3; ++c) S[a][c] = S[c][a] = 0;
         S[a][a] = 1;
       }
-    Real* L = B.chol[cfg];
+    Real L[6];
     bool ok = S[0][0] > 0;
     if (ok) {
       L[0] = std::sqrt(S[0][0]);
@@ -221,7 +226,23 @@ static void buildBlock(const ConstraintRow* R, PgsBlocks::Block& B) {
         if (ok) L[5] = std::sqrt(p2);
       }
     }
-    B.ok[cfg] = ok && std::isfinite(L[0] + L[1] + L[2] + L[3] + L[4] + L[5]);
+    ok = ok && std::isfinite(L[0] + L[1] + L[2] + L[3] + L[4] + L[5]);
+    // S^-1 = L^-T L^-1 (packed lower, symmetric): a visit is then one 3 x 3 product, nine independent
+    // multiply-adds, instead of two triangular solves whose six dependent divisions were the largest share of
+    // a visit (perf on pyramid20).
+    if (ok) {
+      const Real i0 = 1 / L[0], i2 = 1 / L[2], i5 = 1 / L[5];
+      const Real m10 = -L[1] * i0 * i2, m21 = -L[4] * i2 * i5, m20 = -(L[3] * i0 + L[4] * m10) * i5;
+      Real* Si = B.sInv[cfg];
+      Si[0] = i0 * i0 + m10 * m10 + m20 * m20;  // (0,0)
+      Si[1] = m10 * i2 + m20 * m21;              // (1,0)
+      Si[2] = i2 * i2 + m21 * m21;               // (1,1)
+      Si[3] = m20 * i5;                          // (2,0)
+      Si[4] = m21 * i5;                          // (2,1)
+      Si[5] = i5 * i5;                           // (2,2)
+      ok = std::isfinite(Si[0] + Si[1] + Si[2] + Si[3] + Si[4] + Si[5]);
+    }
+    B.ok[cfg] = ok;
   }
 }
 
@@ -250,15 +271,11 @@ static bool solvePreparedBlock(ConstraintRow* R, const PgsBlocks::Block& B, std:
   }
   if (!B.axisU) b[1] = 0;
   if (!B.axisV) b[2] = 0;
-  const Real* L = B.chol[cfg];
-  // L y = b, L^T dmu = y.
-  const Real y0 = b[0] / L[0];
-  const Real y1 = (b[1] - L[1] * y0) / L[2];
-  const Real y2 = (b[2] - L[3] * y0 - L[4] * y1) / L[5];
+  const Real* Si = B.sInv[cfg];
   Real dmu[3];
-  dmu[2] = y2 / L[5];
-  dmu[1] = (y1 - L[4] * dmu[2]) / L[2];
-  dmu[0] = (y0 - L[1] * dmu[1] - L[3] * dmu[2]) / L[0];
+  dmu[0] = Si[0] * b[0] + Si[1] * b[1] + Si[3] * b[2];
+  dmu[1] = Si[1] * b[0] + Si[2] * b[1] + Si[4] * b[2];
+  dmu[2] = Si[3] * b[0] + Si[4] * b[1] + Si[5] * b[2];
   if (!std::isfinite(dmu[0] + dmu[1] + dmu[2])) return false;
   Real dl[kMaxNormalBlock];
   bool inside = true;
@@ -736,6 +753,114 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
       if (change <= kShockTolerance * scale) break;
     }
   }
+}
+
+// ---- issue 18 (sweep scheduling): graph-coloured sweeps (pgs.h PgsColouring) ----
+// DESIGN (docs/solver-internals.md "Coloured sweeps"): greedy colouring in the serial sweep's unit order, the
+// lowest colour neither of a unit's movable bodies holds yet (a 64-bit mask per body), then a stable counting
+// sort of the units by colour. A body's velocity is the only state two units share (a unit's friction rows read
+// only its own normal rows), so units of one colour commute exactly and the thread count cannot change a bit.
+// Static bodies are read by many units of one colour (pyramid20's ground by all 20 bottom boxes); the sweeps
+// add zero impulses to them, which would still be concurrent writes, so each such unit reads a private copy.
+namespace {
+inline bool movable(const SolverBodyState& b) { return b.invMass > 0 || !b.invInertia.isZero(0); }
+}  // namespace
+
+void PgsSolver::colour(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                       PgsColouring& c) {
+  const size_t nu = c.units.size();
+  c.bodyMask.assign(bodies.size(), 0);
+  c.unitColour.resize(nu);
+  constexpr uint8_t kNone = 64;
+  uint32_t count[kNone + 1] = {};
+  for (size_t u = 0; u < nu; ++u) {
+    const PgsColouring::Unit& un = c.units[u];
+    uint64_t used = 0;
+    for (uint32_t i = un.begin; i < un.begin + un.count; ++i)
+      for (const int32_t b : {rows[i].bodyA, rows[i].bodyB})
+        if (b >= 0 && movable(bodies[size_t(b)])) used |= c.bodyMask[size_t(b)];
+    uint8_t col = kNone;
+    if (~used != 0) col = uint8_t(std::countr_zero(~used));
+    c.unitColour[u] = col;
+    ++count[col];
+    if (col == kNone) continue;
+    for (uint32_t i = un.begin; i < un.begin + un.count; ++i)
+      for (const int32_t b : {rows[i].bodyA, rows[i].bodyB})
+        if (b >= 0 && movable(bodies[size_t(b)])) c.bodyMask[size_t(b)] |= uint64_t(1) << col;
+  }
+  int numColours = 0;
+  for (int k = 0; k < kNone; ++k)
+    if (count[k]) numColours = k + 1;
+  c.lastGroupSerial = count[kNone] > 0;
+  const int groups = numColours + (c.lastGroupSerial ? 1 : 0);
+  c.colourStart.assign(size_t(groups) + 1, 0);
+  for (int k = 0; k < numColours; ++k) c.colourStart[size_t(k) + 1] = c.colourStart[size_t(k)] + count[k];
+  if (c.lastGroupSerial) c.colourStart[size_t(groups)] = c.colourStart[size_t(numColours)] + count[kNone];
+  uint32_t next[kNone + 1];
+  for (int k = 0; k < numColours; ++k) next[k] = c.colourStart[size_t(k)];
+  next[kNone] = c.colourStart[size_t(numColours)];
+  c.sorted.resize(nu);
+  for (size_t u = 0; u < nu; ++u) c.sorted[next[c.unitColour[u]]++] = c.units[u];
+}
+
+Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
+                        const PgsBlocks* blocks, PgsColouring& c) {
+  // Private copies of static bodies: one per (unit, side) that reads one.
+  const size_t numBodies = bodies.size();
+  c.remapped.clear();
+  for (const PgsColouring::Unit& un : c.sorted) {
+    int32_t original[2] = {-1, -1}, copy[2] = {-1, -1};
+    for (uint32_t i = un.begin; i < un.begin + un.count; ++i)
+      for (int side = 0; side < 2; ++side) {
+        int32_t& b = side == 0 ? rows[i].bodyA : rows[i].bodyB;
+        if (b < 0 || movable(bodies[size_t(b)])) continue;
+        c.remapped.push_back({i, side, b});
+        if (b != original[side]) {
+          original[side] = b;
+          copy[side] = int32_t(bodies.size());
+          const SolverBodyState body = bodies[size_t(b)];
+          bodies.push_back(body);
+        }
+        b = copy[side];
+      }
+  }
+  const int groups = int(c.colourStart.size()) - 1;
+  const int parallelGroups = groups - (c.lastGroupSerial ? 1 : 0);
+  Real maxDelta = 0;
+  const PgsColouring::Unit* units = c.sorted.data();
+  const uint32_t* start = c.colourStart.data();
+  // Threads pay off only with enough units per colour; the result is the same either way.
+  const bool parallel = c.sorted.size() >= 64;
+#pragma omp parallel if (parallel)
+  {
+    Real local = 0;
+    for (int it = 0; it < iterations; ++it) {
+      const bool forward = it % 2 == 0;
+      local = 0;
+      for (int g = 0; g < groups; ++g) {
+        const int k = forward ? g : groups - 1 - g;
+        if (k >= parallelGroups) {
+#pragma omp single
+          for (uint32_t u = start[k]; u < start[k + 1]; ++u)
+            local = std::max(local, sweepRows(rows, bodies, units[u].begin, units[u].begin + units[u].count,
+                                              forward, blocks));
+          // (implicit barrier)
+          continue;
+        }
+#pragma omp for schedule(static)
+        for (int64_t u = int64_t(start[k]); u < int64_t(start[k + 1]); ++u)
+          local = std::max(local, sweepRows(rows, bodies, units[u].begin, units[u].begin + units[u].count,
+                                            forward, blocks));
+        // (implicit barrier: the next colour sees this one's velocities)
+      }
+    }
+#pragma omp critical(scree_pgs_coloured_max)
+    maxDelta = std::max(maxDelta, local);
+  }
+  // Back to the shared static bodies.
+  for (const PgsColouring::Remap& r : c.remapped) (r.side == 0 ? rows[r.row].bodyA : rows[r.row].bodyB) = r.body;
+  bodies.resize(numBodies);
+  return maxDelta;
 }
 
 }  // namespace scree::detail

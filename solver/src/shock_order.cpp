@@ -35,8 +35,8 @@ void buildShockOrder(SimulationState& s) {
     if (c.ia < 0 && c.ib >= 0 && s.level[c.ib] > 1) { s.level[c.ib] = 1; frontier.push_back(uint32_t(c.ib)); }
     if (c.ib < 0 && c.ia >= 0 && s.level[c.ia] > 1) { s.level[c.ia] = 1; frontier.push_back(uint32_t(c.ia)); }
   }
-  // frontier may hold level-0 and level-1 seeds; process in level order.
-  std::stable_sort(frontier.begin(), frontier.end(), [&](uint32_t x, uint32_t y) { return s.level[x] < s.level[y]; });
+  // frontier holds the level-0 seeds, then the level-1 ones (each loop above pushes one level), so it is already
+  // in level order. (A stable_sort here allocated its buffer every step; issue 18: no per-step allocation.)
   for (size_t head = 0; head < frontier.size(); ++head) {
     const uint32_t b = frontier[head];
     for (uint32_t k : s.adjacency[b]) {
@@ -64,8 +64,15 @@ void buildShockOrder(SimulationState& s) {
     }
     order.push_back({std::min(la, lb), k});
   }
-  std::stable_sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-  for (const auto& [lvl, k] : order) {
+  // Stable counting sort by lower level into reused buffers (std::stable_sort allocated a buffer every step).
+  int maxLevel = 0;
+  for (const auto& e : order) maxLevel = std::max(maxLevel, e.first);
+  s.levelStart.assign(size_t(maxLevel) + 2, 0);
+  for (const auto& e : order) ++s.levelStart[size_t(e.first) + 1];
+  for (size_t l = 1; l < s.levelStart.size(); ++l) s.levelStart[l] += s.levelStart[l - 1];
+  s.orderSorted.resize(order.size());
+  for (const auto& e : order) s.orderSorted[s.levelStart[size_t(e.first)]++] = e;
+  for (const auto& [lvl, k] : s.orderSorted) {
     const auto& c = s.couplings[k];
     const int la = c.ia >= 0 ? s.level[c.ia] : 0, lb = c.ib >= 0 ? s.level[c.ib] : 0;
     s.shock.push_back({c.begin, c.count, la < lb ? 0 : 1});

@@ -87,6 +87,10 @@ struct SimulationState {
   std::vector<PgsSolver::ShockRange> shock;
   std::vector<uint32_t> frontier;
   std::vector<std::pair<int, uint32_t>> order;
+  // ---- issue 18 (sweep cost): reused buffers of the shock order's counting sort (no per-step allocation) ----
+  std::vector<uint32_t> levelStart;
+  std::vector<std::pair<int, uint32_t>> orderSorted;
+  PgsColouring colouring;  // coloured sweeps (Solver::setUseColouredSweeps), storage reused across steps
   // Warm-start source (issue 18, solve_stage.cpp rigidShock): per contact row in the rigid shock pass, the
   // sweeps' impulse (plus, for a single support's normal rows, an even share of the load the pass added); NaN for
   // other rows; empty when no shock pass ran. storeResults caches these instead of the solved impulses.

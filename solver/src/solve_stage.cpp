@@ -194,8 +194,20 @@ void hybridPath(SimulationState& s, bool finalDirect, bool particleDirect) {
   st.lastResidual = residual;
 }
 
+/// The rigid PGS sweeps: serial in row order, or coloured (Solver::setUseColouredSweeps; units = couplings, which
+/// cover every row on these paths).
+Real rigidSweeps(SimulationState& s, int iterations) {
+  if (!s.solver.getUseColouredSweeps()) return PgsSolver::iterate(s.rows, s.sb, iterations, &s.pgsBlocks);
+  return PgsSolver::iterate(s.rows, s.sb, iterations, &s.pgsBlocks, s.colouring);
+}
+
 /// INTERLEAVED and ITERATIVE: PGS sweeps over all rows and particle units, then the shock passes.
 void iterativePath(SimulationState& s, bool interleaved) {
+  if (s.solver.getUseColouredSweeps() && !s.rows.empty()) {
+    s.colouring.units.clear();
+    for (const CouplingRange& c : s.couplings) s.colouring.units.push_back({c.begin, c.count});
+    PgsSolver::colour(s.rows, s.sb, s.colouring);
+  }
   SolverStats& st = s.solverStats();
   const int iterations = s.solver.getNumIterations();
   const bool particles = hasParticleUnits(s);
@@ -203,11 +215,11 @@ void iterativePath(SimulationState& s, bool interleaved) {
   Real residual = 0;
   if (interleaved) {
     for (int it = 0; it < iterations; ++it) {
-      residual = PgsSolver::iterate(s.rows, s.sb, 1, &s.pgsBlocks);
+      residual = rigidSweeps(s, 1);
       residual = std::max(residual, s.particles.sweep(s.granular, s.sb, it % 2 == 1));
     }
   } else {
-    if (!s.rows.empty()) residual = PgsSolver::iterate(s.rows, s.sb, iterations, &s.pgsBlocks);
+    if (!s.rows.empty()) residual = rigidSweeps(s, iterations);
     if (particles)
       for (int it = 0; it < iterations; ++it)
         residual = std::max(residual, s.particles.sweep(s.granular, s.sb, it % 2 == 1));

@@ -37,13 +37,44 @@ struct PgsBlocks {
     Vec3 gLinA[3], gAngA[3], gLinB[3], gAngB[3];
     Vec3 wLinA[3], wAngA[3], wLinB[3], wAngB[3];
     Real dRhs[3];  ///< sum_i D_ai rhs_i
-    /// Cholesky factor (lower, row-major packed: l00 l10 l11 l20 l21 l22) of D (K + E) D^T with both bodies
-    /// free [0], body A frozen [1], body B frozen [2]; ok[k] false when that system is not positive definite.
-    Real chol[3][6];
+    /// Inverse (symmetric, lower row-major packed: s00 s10 s11 s20 s21 s22) of D (K + E) D^T with both bodies
+    /// free [0], body A frozen [1], body B frozen [2], from its Cholesky factor; ok[k] false when that system is
+    /// not positive definite.
+    Real sInv[3][6];
     bool ok[3];
     bool axisU, axisV;
   };
   std::vector<Block> blocks;
+};
+
+// ---- issue 18 (sweep scheduling): graph-coloured sweeps (pgs.cpp, docs/solver-internals.md "Coloured sweeps") ----
+/// The rows cut into units (one contact's or one joint's rows: every row of a unit acts on the same two bodies)
+/// and the units into colours such that no two units of one colour share a body the sweeps can move (static and
+/// kinematic bodies -- zero inverse mass and inertia -- do not count). A coloured sweep visits the colours in a
+/// fixed order and, within a colour, units that touch disjoint bodies, so the units of a colour can be swept by
+/// any number of threads in any order with bit-identical results. Kept by the caller across steps (storage
+/// reused: no per-step allocation once grown).
+struct PgsColouring {
+  struct Unit {
+    uint32_t begin, count;
+  };
+  /// Input: the units in the order the serial sweep visits them (PgsSolver::colour reorders them by colour).
+  std::vector<Unit> units;
+  /// Output: colour c holds units [colourStart[c], colourStart[c + 1]); units that found no colour among the
+  /// first 64 are the last group, swept by one thread.
+  std::vector<uint32_t> colourStart;
+  bool lastGroupSerial = false;
+  // Scratch (reused).
+  std::vector<uint64_t> bodyMask;
+  std::vector<uint8_t> unitColour;
+  std::vector<Unit> sorted;
+  /// Rows whose static body was given a private copy for the sweeps (row index, side, original body index).
+  struct Remap {
+    uint32_t row;
+    int side;
+    int32_t body;
+  };
+  std::vector<Remap> remapped;
 };
 
 class PgsSolver {
@@ -56,6 +87,16 @@ class PgsSolver {
   /// must be the one given to prepare (or null).
   static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
                       const PgsBlocks* blocks = nullptr);
+  /// Colours `colouring.units` (PgsColouring) for the given rows and bodies; call after prepare, every step.
+  static void colour(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                     PgsColouring& colouring);
+  /// `iterations` coloured sweeps (alternating forward and backward: colours in increasing order and each unit's
+  /// rows forward, then colours in decreasing order and rows backward), the units of a colour shared among the
+  /// OpenMP threads. Results do not depend on the number of threads. A unit that touches a static body gets a
+  /// private copy of it for the sweeps (appended to `bodies` and removed again), so that no two threads write
+  /// the same body even with zero impulses. Returns the largest |delta lambda| of the last sweep.
+  static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
+                      const PgsBlocks* blocks, PgsColouring& colouring);
   /// The same sweeps over the rows listed in `subset` only (ascending indices; a projected-cone pair must be
   /// listed whole); the other rows' impulses are held fixed. Used by the hybrid direct/iterative solve.
   static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,

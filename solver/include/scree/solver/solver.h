@@ -126,6 +126,14 @@ class Solver {
   /// check off. Default 0.1.
   void setConstraintErrorThreshold(Real e);
   Real getConstraintErrorThreshold() const { return constraintErrorThreshold_; }
+  // ---- issue 18 (sweep scheduling): graph-coloured sweeps ----
+  /// Graph-coloured PGS sweeps (default off; PgsColouring, docs/solver-internals.md "Coloured sweeps"): each
+  /// contact's and joint's rows are one unit, units are coloured so that no two of a colour share a dynamic
+  /// body, and the sweeps visit the colours in a fixed order with a colour's units shared among the threads
+  /// (setNumThreads). Results are bit-identical for any thread count. The visiting order differs from the
+  /// default serial order (contacts in contact-list order), so trajectories differ from the default's.
+  void setUseColouredSweeps(bool on) { colouredSweeps_ = on; }
+  bool getUseColouredSweeps() const { return colouredSweeps_; }
   const SolverStats& getStats() const { return stats_; }
 
  private:
@@ -146,6 +154,7 @@ class Solver {
   Real projectionTolerance_ = 2e-3;
   Real constraintErrorThreshold_ = 0.1;
   SolverStats stats_;
+  bool colouredSweeps_ = false;  // issue 18 (sweep scheduling)
 };
 
 }  // namespace scree

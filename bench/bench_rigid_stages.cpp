@@ -1,0 +1,142 @@
+// Per-stage step timings (Simulation::getTimings) of the rigid reference scenes pyramid20 and tower10
+// (docs/scenes.md), on 1 and 2 threads (issue 18: where a small rigid scene's step goes, and the two-thread
+// speed-up of the coloured sweeps, docs/solver-internals.md "Sweep cost" and "Coloured sweeps").
+//
+// One benchmark iteration is one complete run of the scene's defined steps (scene built with the timer paused).
+// Counters:
+//   median_ms   median wall time of one step over the run (ms)
+//   cpu_ms      process CPU time per step (all threads), mean over the run (ms)
+//   st_<stage>  Simulation::getTimings() per stage, mean over the run (ms); collide = syncGeometries +
+//               collideGeometries + resolveMaterials; rows = contactRows + constraintRows
+//   drift_cm    pyramid20: largest box displacement at the end (cm); tower10: top box's horizontal offset
+//   allocs      heap allocations (global operator new) per step after the first 60 steps (storage has grown by
+//               then; issue 18 asks for none in a rigid step)
+//   fingerprint low 32 bits of an FNV-1a hash of every body's final position and velocity (the same on 1 and 2
+//               threads: the sweeps' results do not depend on the thread count)
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <ctime>
+#include <new>
+#include <vector>
+
+#include "scenes/scenes.h"
+
+// Counts every heap allocation of the process (this benchmark binary only; the replacement operator new pairs
+// with the replacement operator delete below, which GCC cannot see).
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+static std::atomic<long> gAllocations{0};
+void* operator new(std::size_t n) {
+  gAllocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace {
+using namespace scree;
+using namespace scree::scenes;
+using Clock = std::chrono::steady_clock;
+
+double cpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+
+uint64_t fingerprint(const Simulation& sim) {
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&](const Vec3& v) {
+    const auto* p = reinterpret_cast<const unsigned char*>(v.data());
+    for (size_t q = 0; q < sizeof(Real) * 3; ++q) h = (h ^ p[q]) * 1099511628211ull;
+  };
+  for (const RigidBodyRef& b : sim.getRigidBodies()) {
+    mix(b->getPosition());
+    mix(b->getVelocity());
+  }
+  return h;
+}
+
+template <class S, class Build, class Drift>
+void runStages(benchmark::State& state, Build build, Drift drift) {
+  const int threads = int(state.range(0));
+  setNumThreads(threads);
+  std::vector<double> wall;
+  StepTimings sum;
+  double cpu = 0, driftCm = 0;
+  long steps = 0, allocSteps = 0, allocs = 0;
+  uint64_t fp = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    S s = build();
+    state.ResumeTiming();
+    for (int i = 0; i < s.numSteps; ++i) {
+      const long a0 = gAllocations.load(std::memory_order_relaxed);
+      const double c0 = cpuMs();
+      const auto t0 = Clock::now();
+      s.step();
+      wall.push_back(std::chrono::duration<double>(Clock::now() - t0).count() * 1e3);
+      cpu += cpuMs() - c0;
+      if (i >= 60) {
+        allocs += gAllocations.load(std::memory_order_relaxed) - a0;
+        ++allocSteps;
+      }
+      sum += s.sim->getTimings();
+      ++steps;
+    }
+    driftCm = drift(s) * 100;
+    fp = fingerprint(*s.sim);
+  }
+  setNumThreads(1);
+  std::nth_element(wall.begin(), wall.begin() + long(wall.size() / 2), wall.end());
+  const double n = double(std::max(1L, steps));
+  state.counters["median_ms"] = wall[wall.size() / 2];
+  state.counters["cpu_ms"] = cpu / n;
+  state.counters["st_collide"] = (sum.syncGeometries + sum.collideGeometries + sum.resolveMaterials) / n;
+  state.counters["st_rows"] = (sum.contactRows + sum.constraintRows) / n;
+  state.counters["st_solve"] = sum.solve / n;
+  state.counters["st_integrate"] = sum.integrateMotion / n;
+  state.counters["st_store"] = sum.storeResults / n;
+  state.counters["st_other"] = (sum.total - sum.syncGeometries - sum.collideGeometries - sum.resolveMaterials -
+                                sum.contactRows - sum.constraintRows - sum.solve - sum.integrateMotion -
+                                sum.storeResults) / n;
+  state.counters["st_total"] = sum.total / n;
+  state.counters["drift_cm"] = driftCm;
+  state.counters["allocs"] = double(allocs) / double(std::max(1L, allocSteps));
+  state.counters["fingerprint"] = double(fp & 0xffffffffu);
+}
+
+void BM_pyramid20_stages(benchmark::State& state) {
+  runStages<PyramidScene>(state, [] { return buildPyramid20(); },
+                          [](const PyramidScene& s) { return measurePyramid(s).maxDisplacement; });
+}
+BENCHMARK(BM_pyramid20_stages)->Arg(1)->Arg(2)->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The same with graph-coloured sweeps (Solver::setUseColouredSweeps): the 1- and 2-thread fingerprints agree.
+void BM_pyramid20_coloured_stages(benchmark::State& state) {
+  runStages<PyramidScene>(state,
+                          [] {
+                            PyramidScene s = buildPyramid20();
+                            s.sim->getSolver().setUseColouredSweeps(true);
+                            return s;
+                          },
+                          [](const PyramidScene& s) { return measurePyramid(s).maxDisplacement; });
+}
+BENCHMARK(BM_pyramid20_coloured_stages)->Arg(1)->Arg(2)->Iterations(1)->Repetitions(3)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_tower10_stages(benchmark::State& state) {
+  runStages<TowerScene>(state, [] { return buildTower10(); },
+                        [](const TowerScene& s) { return measureTower(s).topHorizontal; });
+}
+BENCHMARK(BM_tower10_stages)->Arg(1)->Arg(2)->Iterations(5)->Repetitions(3)->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
