@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Per-stage step timings (Simulation::getTimings) of the rigid reference scenes pyramid20 and tower10
 // (docs/scenes.md), on 1 and 2 threads (issue 18: where a small rigid scene's step goes, and the two-thread
 // speed-up of the coloured sweeps, docs/solver-internals.md "Sweep cost" and "Coloured sweeps").

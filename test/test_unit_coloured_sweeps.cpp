@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Graph-coloured PGS sweeps (Solver::setUseColouredSweeps, PgsColouring; docs/solver-internals.md "Coloured
 // sweeps"): the colouring's invariant on hand-built rows, and pyramid20's trajectory bit-identical on 1 and 2
 // threads.
