@@ -112,9 +112,9 @@ void Terrain::syncParticleContactMaterials(ParticleMaterialCache& c) {
   }
   mm.add(c.self);
 
-  // DIRECT mode: the lump's support by the terrain goes into the direct solve too (SPLIT: normals direct,
-  // friction iterative). The direct solve holds its impulses while the particle sweeps run afterwards, so a
-  // glued lump on ITERATIVE support contacts does not feel them: it falls through them (terrain.h).
+  // DIRECT mode: the lump's support by the terrain is ITERATIVE, explicitly (a user's SPLIT or DIRECT terrain
+  // material would put bounded rows, i.e. pivots, into the lump's direct solve); the solve stage alternates the
+  // direct solve of the bonds with the sweeps over these contacts and ends with the direct solve (terrain.h).
   const MaterialRef groundMat = defaultMaterial();
   if (c.ground && (di.particleSolveType_ != FrictionModel::DIRECT || c.groundMaterial != groundMat)) {
     mm.remove(c.ground);
@@ -127,7 +127,7 @@ void Terrain::syncParticleContactMaterials(ParticleMaterialCache& c) {
     SurfaceParameters sp;
     mm.resolve(c.material.get(), groundMat.get(), sp, nullptr);
     copySurface(sp, *c.ground);
-    c.ground->setSolveType(FrictionModel::SPLIT);
+    c.ground->setSolveType(FrictionModel::ITERATIVE);
     mm.add(c.ground);
   }
 
@@ -157,7 +157,10 @@ void Terrain::syncParticleContactMaterials(ParticleMaterialCache& c) {
     copySurface(sp, *cm);
     cm->setYoungsModulus(std::max(ext->getYoungsModulus(), src.getYoungsModulus()));
     cm->setSurfaceViscosity(ext->getSurfaceViscosity());
-    cm->setSolveType(FrictionModel::SPLIT);
+    // DIRECT particle mode: ITERATIVE, so the direct solve holds only the lump's equality bonds (no pivot) and
+    // the bucket's contacts are swept between its direct solves (solve_stage.cpp, lumpPath).
+    cm->setSolveType(di.particleSolveType_ == FrictionModel::DIRECT ? FrictionModel::ITERATIVE
+                                                                     : FrictionModel::SPLIT);
     mm.add(cm);
   }
 }

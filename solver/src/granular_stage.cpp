@@ -270,6 +270,11 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     return b.invMass + c.dot(b.invInertia * c);
   };
 
+  // DIRECT lump bonds (see bondRest_ in the header): this step's rest per particle pair, NaN for a non-bond.
+  const bool anyBondRest = !bondRest_.empty() || anyGluedMaterial(ppParams, K);
+  if (anyBondRest) ppRest_.assign(pp.size(), std::numeric_limits<Real>::quiet_NaN());
+  else ppRest_.clear();
+
 #pragma omp parallel for schedule(static) if (numUnits > kParallelMin)
   for (size_t k = 0; k < pp.size() + pg.size(); ++k) {
     const bool isPP = k < pp.size();
@@ -353,6 +358,11 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
         ce = find(pgKeys_, pgFirst_, pgCache_, slotKey(ps, a) << 32 | sides[k - pp.size()].geometryId, c.featureId);
       }
     }
+    uint64_t pairKey = 0;  // only glued bonds need it (bondRest_)
+    if (isPP && anyBondRest) {
+      const uint64_t sa = slotKey(ps, a), sb = slotKey(ps, size_t(c.b));
+      pairKey = u.flip ? (sb << 32 | sa) : (sa << 32 | sb);
+    }
     const Real vn0 = u.n.dot(vrel);
     const Real vnFree = vn0 + (isPP ? 0.0 : h * gravity.dot(u.n));
     // Speculative contacts stop an approach exactly at the surface; the approach speed is then remembered so
@@ -373,6 +383,17 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     // elastically past touching (adhesive overlap 0 under tension, some 1e-7 m) stays a bond.
     const bool gapBond = isPP && isGapBond(c, p);  // as in the plan above
     if (gapBond) cs.adhesiveForce = 0;
+    // A glued bond rests at the overlap it had when it formed (bondRest_): on the creation lattice that is the
+    // material's r(sqrt2 - 1); a bond formed later, e.g. between particles of two dig steps, is not pushed.
+    // A bond formed this step captures the pair inelastically: the row targets zero relative normal velocity
+    // (SPOOK's damping term would carry most of the approach speed into the bond, which then swings back over
+    // many steps: a particle dug during the lift, at rest, bonding to the rising lump deformed it by 7.5e-5 m).
+    if (isPP && std::isinf(p.adhF) && !gapBond && anyBondRest) {
+      bool formed = false;
+      cs.adhesiveOverlap = bondRestOf(pairKey, c.depth, formed);
+      ppRest_[k] = cs.adhesiveOverlap;
+      if (!formed) cs.vn0 = 0;
+    }
     // Per-point overrides (ContactEventListener::particleContacts), as ContactPoint's for rigid contacts.
     cs.restitution = c.restitution >= 0 ? c.restitution : p.rest;
     const bool ownSpook = c.youngsModulus > 0 || c.damping >= 0;
@@ -731,6 +752,7 @@ void GranularStage::appendDirectRows(const GranularBodySystem& ps, std::vector<C
   extBody_.assign(ps.size(), -1);
   extParticle_.clear();
   directRow_.clear();
+  glued_ = false;
   auto bodyOf = [&](size_t i) {
     if (extBody_[i] < 0) {
       extBody_[i] = int32_t(bodies.size());
@@ -749,6 +771,7 @@ void GranularStage::appendDirectRows(const GranularBodySystem& ps, std::vector<C
     const int32_t ia = bodyOf(u.a);
     const int32_t ib = u.b >= 0 ? bodyOf(size_t(u.b)) : u.body;
     const auto type = FrictionModel::SolveType(u.solveType);
+    glued_ |= type == FrictionModel::DIRECT;
     const int32_t normal = int32_t(rows.size());
     directRow_.push_back(uint32_t(normal));
     // Same rows as solveUnit: impulse P along +d on a, -d on b (or the body); J v = relative velocity along d.
@@ -837,6 +860,37 @@ void GranularStage::finishDirect(GranularBodySystem& ps, std::vector<ConstraintR
   bodies.resize(bodyBase_);
 }
 
+bool GranularStage::anyGluedMaterial(const std::vector<PairParams>& ppParams, size_t K) {
+  for (size_t e = 0; e < K * K && e < ppParams.size(); ++e)
+    if (std::isinf(ppParams[e].adhF)) return true;
+  return false;
+}
+
+Real GranularStage::bondRestOf(uint64_t key, Real depth, bool& found) const {
+  const auto first = std::make_pair(key, -std::numeric_limits<Real>::infinity());
+  auto it = std::lower_bound(bondRest_.begin(), bondRest_.end(), first);
+  found = it != bondRest_.end() && it->first == key;
+  return found ? it->second : depth;
+}
+
+void GranularStage::directToParticles(GranularBodySystem& ps, const std::vector<SolverBodyState>& bodies) const {
+  auto& v = ps.velocities();
+  auto& w = ps.angularVelocities();
+  for (size_t k = 0; k < extParticle_.size(); ++k) {
+    v[extParticle_[k]] = bodies[bodyBase_ + k].v;
+    w[extParticle_[k]] = bodies[bodyBase_ + k].w;
+  }
+}
+
+void GranularStage::particlesToDirect(const GranularBodySystem& ps, std::vector<SolverBodyState>& bodies) const {
+  const auto& v = ps.velocities();
+  const auto& w = ps.angularVelocities();
+  for (size_t k = 0; k < extParticle_.size(); ++k) {
+    bodies[bodyBase_ + k].v = v[extParticle_[k]];
+    bodies[bodyBase_ + k].w = w[extParticle_[k]];
+  }
+}
+
 void GranularStage::integrate(GranularBodySystem& ps, Real h, std::vector<size_t>& outNonFinite,
                               std::vector<std::string>& outMessages, Real time) {
   const size_t n = ps.size();
@@ -875,6 +929,16 @@ void GranularStage::storeResults(const GranularBodySystem& ps, const ParticleCon
   const Real invH = 1.0 / h;
   ppCache_.clear();
   pgCache_.clear();
+  bondRest_.clear();
+  for (size_t k = 0; k < ppRest_.size(); ++k)
+    if (!std::isnan(ppRest_[k])) {
+      // The pair's key as buildRows made it (lower slot first).
+      const ParticleContact& c = pp[k];
+      if (!ps.isAliveDense(c.a) || !ps.isAliveDense(size_t(c.b))) continue;
+      const uint64_t sa = slotKey(ps, c.a), sb = slotKey(ps, size_t(c.b));
+      bondRest_.push_back({sa > sb ? (sb << 32 | sa) : (sa << 32 | sb), ppRest_[k]});
+    }
+  std::sort(bondRest_.begin(), bondRest_.end());
   for (const Unit& u : units_) {
     if (!ps.isAliveDense(u.a) || (u.b >= 0 && !ps.isAliveDense(size_t(u.b)))) continue;
     const Vec3 F = u.lT1 * u.t1 + u.lT2 * u.t2;

@@ -51,6 +51,11 @@
 // bodies. Then the iterative units are swept as before, with the direct impulses held. With iterative rigid
 // rows present the hybrid alternation applies (Solver::setNumHybridRounds direct solves per step). Without
 // DIRECT-mode units nothing of this runs: the cost is one comparison per unit in partition.
+// Glued lumps (some unit of solve type DIRECT, with iterative units besides: the terrain's DIRECT particle mode,
+// whose bucket and terrain contacts are ITERATIVE): the solve stage alternates the direct solve with particle
+// sweeps, copying velocities between the appended bodies and the particle arrays (directToParticles,
+// particlesToDirect), and ends with the direct solve (solve_stage.cpp, lumpPath). A glued bond rests at the
+// overlap it formed with and is captured inelastically in the step it forms (bondRest_ below).
 #pragma once
 
 #include <cstdint>
@@ -127,6 +132,15 @@ class GranularStage {
   /// After the solve: impulses back into the units, velocities back into the particle arrays, and the appended
   /// rows and bodies removed again.
   void finishDirect(GranularBodySystem& ps, std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies);
+  // ---- DIRECT lump rounds (issue 16: a dug DIRECT lump carried as one body; solve_stage.cpp, lumpPath) -------
+  /// True when some DIRECT-mode unit is of solve type DIRECT (a glued particle bond of the manual's DIRECT
+  /// particle mode) and iterative units exist: then the solve stage alternates the direct solve with the
+  /// particle sweeps and ends with the direct solve (valid between appendDirectRows and finishDirect).
+  bool needsLumpRounds() const { return glued_ && hasIterativeUnits(); }
+  /// Velocities of the appended bodies into the particle arrays (before particle sweeps inside the rounds).
+  void directToParticles(GranularBodySystem& ps, const std::vector<SolverBodyState>& bodies) const;
+  /// Velocities of the particle arrays into the appended bodies (after the sweeps, before the next direct solve).
+  void particlesToDirect(const GranularBodySystem& ps, std::vector<SolverBodyState>& bodies) const;
   /// Positions; non-finite particles are appended to outNonFinite (ids) with a message each.
   void integrate(GranularBodySystem& ps, Real h, std::vector<size_t>& outNonFinite, std::vector<std::string>& outMessages,
                  Real time);
@@ -236,6 +250,17 @@ class GranularStage {
   std::vector<int32_t> extBody_;       // [size()] solver body of a particle, -1 none
   std::vector<uint32_t> extParticle_;  // particle of each appended body
   std::vector<uint32_t> directRow_;    // first row of each DIRECT-mode unit (normal, [2 friction], [2 rolling])
+  bool glued_ = false;                 // some appended unit is of solve type DIRECT (needsLumpRounds)
+  // Glued bonds (infinite adhesion, the DIRECT particle mode; issue 16). DESIGN: a bond rests at the overlap
+  // it had when it formed, not at the material's adhesive overlap: particles of different dig steps (two
+  // lattices) or a lump landing bond at whatever overlap they meet, and pushing each such bond to one common
+  // rest with its SPOOK bias, against the bonds around it, made a carried lump creep by mm per second
+  // (docs/terrain.md). Kept like the warm start, by the pair's slot key; a pair that leaves contact or opens a
+  // gap (no longer a bond) forgets it.
+  std::vector<std::pair<uint64_t, Real>> bondRest_;  // (pair key, rest overlap), sorted; from storeResults
+  std::vector<Real> ppRest_;                         // [pp contacts] this step's rest, NaN: not a glued bond
+  static bool anyGluedMaterial(const std::vector<PairParams>& ppParams, size_t K);
+  Real bondRestOf(uint64_t key, Real depth, bool& found) const;  // the remembered rest of the pair, else `depth`
 };
 
 }  // namespace scree::detail

@@ -365,17 +365,18 @@
 //         rest overlap stays the lattice's r(sqrt2 - 1), not the manual's 0: in Scree the bonds need no pivot
 //         because their bounds are infinite, whatever the overlap, while a rest overlap of 0 would push every
 //         lattice bond from r(3 - sqrt2) apart to 2r - the lump would swell by 26% in size (2x in volume) the
-//         moment it is dug. Also in DIRECT, the particles' contacts with the terrain geometry's material are
-//         SPLIT: the direct solve holds its impulses while the particle sweeps run after it, so a glued lump on
-//         ITERATIVE support contacts hardly feels them (measured: a dug lump on ITERATIVE terrain contacts was
-//         thrown apart within 4 steps, 37 m/s; and on an ITERATIVE, unregistered blade it fell at g).
-//         DIRECT therefore needs the shovel registered as external (its contacts SPLIT).
+//         moment it is dug. Also in DIRECT, the particles' contacts with the terrain geometry's material and
+//         with external materials are ITERATIVE: the direct solve then holds only equality rows (no pivot, as
+//         the manual requires of this mode), and the solve stage alternates it with the particle sweeps over
+//         those contacts and ends the step with it, so the lump's velocities satisfy its bonds
+//         (solver/src/solve_stage.cpp, lumpPath; docs/terrain.md). DIRECT still needs the shovel registered as
+//         external (otherwise the soft soil combination is met, as in the FAQ failure).
 //       SPLIT and DIRECT_AND_ITERATIVE are rejected: with infinite friction their friction rows would be
 //         unbounded PGS rows.
 //   * with every external material (TerrainDataInterface::addExternalMaterial, the bucket's steel): the
 //     parameters with which the source material meets it (the user's explicit contact material of the two, or
-//     the combination), with E = max(E_external, E_source), solve type SPLIT (PGS without SuiteSparse, as
-//     everywhere) and the external material's surface viscosity (the bucket sets how friction on it yields,
+//     the combination), with E = max(E_external, E_source), solve type SPLIT (ITERATIVE in the DIRECT particle
+//     mode, above; PGS without SuiteSparse, as everywhere) and the external material's surface viscosity (the bucket sets how friction on it yields,
 //     whatever soil slides on it). removeExternalMaterial unregisters them.
 // Why: particles meet everything else through the combination with the soil's own, soft, parameters - the
 // manual's FAQ failure: they sink into and fall through the bucket, and newly made particles tunnel through the
@@ -384,7 +385,7 @@
 // over the step's particle-geometry contacts and returns at once while the terrain has no particles.
 //
 // The shovel read-outs (digging force, fill) and the ground cutting force are below (TerrainShovelStats).
-// Not yet: the DIRECT lump is not rigid when dug and carried by a bucket (docs/terrain.md).
+// Not yet: the DIRECT lump dug and carried by a bucket drifts 1e-5 to 6e-5 m, not < 1e-6 (docs/terrain.md).
 #pragma once
 
 #include <algorithm>
@@ -816,7 +817,7 @@ class Terrain : public Model {
     MaterialRef sourceRef;                                       ///< keeps source alive for its parameters
     ContactMaterialRef self;                                     ///< (material, material)
     std::vector<std::pair<MaterialRef, ContactMaterialRef>> external;  ///< (external material, its contact)
-    ContactMaterialRef ground;  ///< DIRECT mode: (material, terrain geometry's material), SPLIT; else null
+    ContactMaterialRef ground;  ///< DIRECT mode: (material, terrain geometry's material), ITERATIVE; else null
     MaterialRef groundMaterial;
   };
   std::vector<ParticleMaterialCache> particleMaterials_;
