@@ -21,10 +21,10 @@
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
-#include <ctime>
 #include <new>
 #include <vector>
 
+#include "cpu_time.h"
 #include "scenes/scenes.h"
 
 // Counts every heap allocation of the process (this benchmark binary only; the replacement operator new pairs
@@ -44,11 +44,7 @@ using namespace scree;
 using namespace scree::scenes;
 using Clock = std::chrono::steady_clock;
 
-double cpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
-}
+using scree::bench::cpuMs;
 
 uint64_t fingerprint(const Simulation& sim) {
   uint64_t h = 1469598103934665603ull;

@@ -33,11 +33,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <vector>
 
+#include "cpu_time.h"
 #include "scenes/terrain_dig.h"
 
 namespace {
@@ -45,13 +45,7 @@ using namespace scree;
 using namespace scree::scenes;
 using Clock = std::chrono::steady_clock;
 
-/// CPU time of the whole process (all threads), ms: unlike the wall clock it does not count the time the
-/// shared machine gave to other processes.
-double cpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
-}
+using scree::bench::cpuMs;
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;

@@ -162,23 +162,27 @@ StackPart convexPart(Real half = 0.2) { return {convexCube(half), 2 * half}; }
 constexpr Real kMaxDrift = 0.01;
 constexpr Real kDropPerBody = 0.002;
 
+/// A free geometry of shape s at p, turned by q (for narrowphase-only cases).
+GeometryRef place(const ShapeRef& s, const Vec3& p, const Quat& q) {
+  auto g = std::make_shared<Geometry>(s);
+  g->setRotation(q);
+  g->setPosition(p);
+  return g;
+}
+
+/// The points' feature ids, sorted (compared across calls to check that ids persist).
+std::vector<uint32_t> ids(const std::vector<ContactPoint>& c) {
+  std::vector<uint32_t> v;
+  for (const auto& p : c) v.push_back(p.featureId);
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
 }  // namespace
 
 TEST_SUITE("convex manifolds") {
 
 TEST_CASE("narrowphase: manifolds from the supporting features, exact depths, persistent feature ids") {
-  auto place = [](const ShapeRef& s, const Vec3& p, const Quat& q) {
-    auto g = std::make_shared<Geometry>(s);
-    g->setRotation(q);
-    g->setPosition(p);
-    return g;
-  };
-  auto ids = [](const std::vector<ContactPoint>& c) {
-    std::vector<uint32_t> v;
-    for (const auto& p : c) v.push_back(p.featureId);
-    std::sort(v.begin(), v.end());
-    return v;
-  };
   const Real r = 0.2, hh = 0.2, tilt = 0.02;
   SUBCASE("a cylinder tilted 0.02 rad on a wider cylinder's cap: 4 points, the deepest one exact") {
     // Below: r 0.3 cap at z = 0 (the reference: larger). Above: tilted about x, its centre at zc; its lowest rim
@@ -253,18 +257,6 @@ TEST_CASE("narrowphase: manifolds from the supporting features, exact depths, pe
 // of half size h turned 45 deg about x has its bottom edge along x, its ends at x = xc -+ h; every point of the
 // edge is 1 mm deep (placed so); a cap of radius R clips the edge where it leaves the circle, x = +-sqrt(R^2 - y^2).
 TEST_CASE("narrowphase: an edge on a face or a cap gets two points, the edge clipped (hull, box, capsule)") {
-  auto place = [](const ShapeRef& s, const Vec3& p, const Quat& q) {
-    auto g = std::make_shared<Geometry>(s);
-    g->setRotation(q);
-    g->setPosition(p);
-    return g;
-  };
-  auto ids = [](const std::vector<ContactPoint>& c) {
-    std::vector<uint32_t> v;
-    for (const auto& p : c) v.push_back(p.featureId);
-    std::sort(v.begin(), v.end());
-    return v;
-  };
   const Quat onEdge(Eigen::AngleAxis<Real>(kPi / 4, Vec3::UnitX()));
   const Real h = 0.1, depth = 1e-3, zc = h * std::sqrt(Real(2)) - depth, xc = 0.02, yc = 0.01;
   auto cap = place(std::make_shared<Cylinder>(0.3, 0.4), Vec3(0, 0, -0.2), upright());  // cap at z = 0
@@ -592,12 +584,6 @@ TEST_CASE("coaxial equal caps: the same 4 rim points and feature ids under round
   auto upper = std::make_shared<Geometry>(std::make_shared<Cylinder>(R, 2 * hh));
   lower->setRotation(upright());
   lower->setPosition(Vec3(0, 0, hh));
-  auto ids = [](const std::vector<ContactPoint>& c) {
-    std::vector<uint32_t> v;
-    for (const auto& p : c) v.push_back(p.featureId);
-    std::sort(v.begin(), v.end());
-    return v;
-  };
   std::vector<uint32_t> first;
   int variants = 0;
   for (Real dx : {0.0, 1e-16, -3e-16, 1e-15})
