@@ -891,6 +891,89 @@ void GranularStage::particlesToDirect(const GranularBodySystem& ps, std::vector<
   }
 }
 
+// ---- DIRECT lump: rigid integration of a bonded lump's positions (issue 16, second pass; header) ------------
+void GranularStage::integrateBondedLumps(GranularBodySystem& ps, const std::vector<ParticleContact>& pp, Real h) {
+  lumpMoved_.clear();
+  if (ppRest_.size() != pp.size()) return;
+  const size_t n = ps.size();
+  // Union-find over this step's glued bonds.
+  std::vector<uint32_t> parent;
+  auto find = [&](uint32_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  bool any = false;
+  for (size_t k = 0; k < pp.size(); ++k) {
+    const ParticleContact& c = pp[k];
+    if (std::isnan(ppRest_[k]) || c.b < 0 || !c.enabled || c.a >= n || size_t(c.b) >= n) continue;
+    if (!any) {
+      parent.resize(n);
+      for (size_t i = 0; i < n; ++i) parent[i] = uint32_t(i);
+      any = true;
+    }
+    const uint32_t ra = find(c.a), rb = find(uint32_t(c.b));
+    if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+  }
+  if (!any) return;
+  auto& x = ps.positions();
+  auto& v = ps.velocities();
+  const auto& invM = ps.invMasses();
+  // Members of each cluster of >= 3 live dynamic particles (roots are the smallest index of their cluster).
+  std::vector<uint32_t> count(n, 0);
+  for (size_t i = 0; i < n; ++i)
+    if (invM[i] > 0 && ps.isAliveDense(i)) ++count[find(uint32_t(i))];
+  std::vector<std::vector<uint32_t>> members;
+  std::vector<int> slot(n, -1);
+  for (size_t i = 0; i < n; ++i) {
+    if (invM[i] <= 0 || !ps.isAliveDense(i)) continue;
+    const uint32_t r = find(uint32_t(i));
+    if (count[r] < 3) continue;
+    if (slot[r] < 0) {
+      slot[r] = int(members.size());
+      members.emplace_back();
+      members.back().reserve(count[r]);
+    }
+    members[size_t(slot[r])].push_back(uint32_t(i));
+  }
+  lumpMoved_.assign(n, 0);
+  for (const auto& mem : members) {
+    Real M = 0;
+    Vec3 xc = Vec3::Zero(), vc = Vec3::Zero();
+    for (uint32_t i : mem) {
+      const Real m = 1.0 / invM[i];
+      M += m;
+      xc += m * x[i];
+      vc += m * v[i];
+    }
+    xc /= M;
+    vc /= M;
+    Mat3 I = Mat3::Zero();
+    Vec3 L = Vec3::Zero();
+    for (uint32_t i : mem) {
+      const Real m = 1.0 / invM[i];
+      const Vec3 r = x[i] - xc;
+      I += m * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
+      L += m * r.cross(v[i] - vc);
+    }
+    const Eigen::LDLT<Mat3> ldlt(I);
+    // A straight chain has a singular inertia (no angular velocity about its axis is defined): x += h v.
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-12 * I.trace())) continue;
+    const Vec3 w = ldlt.solve(L);
+    if (!w.allFinite() || !xc.allFinite() || !vc.allFinite()) continue;  // integrate reports it
+    const Real angle = h * w.norm();
+    const Mat3 R = angle > 0 ? Mat3(Eigen::AngleAxis<Real>(angle, w.normalized())) : Mat3::Identity();
+    const Vec3 xcNext = xc + h * vc;
+    for (uint32_t i : mem) {
+      const Vec3 r = x[i] - xc;
+      const Vec3 dv = v[i] - vc - w.cross(r);  // non-rigid velocity
+      const Vec3 rn = R * r;
+      x[i] = xcNext + rn + h * dv;
+      v[i] = vc + w.cross(rn) + R * dv;
+      lumpMoved_[i] = 1;
+    }
+  }
+}
+
 void GranularStage::integrate(GranularBodySystem& ps, Real h, std::vector<size_t>& outNonFinite,
                               std::vector<std::string>& outMessages, Real time) {
   const size_t n = ps.size();
@@ -899,9 +982,10 @@ void GranularStage::integrate(GranularBodySystem& ps, Real h, std::vector<size_t
   auto& w = ps.angularVelocities();
   const auto& invM = ps.invMasses();
   bool bad = false;
+  const bool skipLumps = lumpMoved_.size() == n;
 #pragma omp parallel for schedule(static) if (n > kParallelMin) reduction(|| : bad)
   for (size_t i = 0; i < n; ++i) {
-    if (invM[i] <= 0) continue;
+    if (invM[i] <= 0 || (skipLumps && lumpMoved_[i])) continue;
     const Vec3 xn = x[i] + h * v[i];
     if (xn.allFinite() && w[i].allFinite()) x[i] = xn;
     else bad = true;

@@ -31,7 +31,8 @@
 //                and with the tangents' angular parts as multiples of the basis (about half the arithmetic;
 //                docs/terrain.md, "Digging cost").
 //   integrate    x += h v for live particles; a particle whose velocity or position turns non-finite is
-//                reported by id, keeps its last position and is stopped.
+//                reported by id, keeps its last position and is stopped. Clusters joined by glued DIRECT bonds
+//                move by their exactly integrated rigid motion first (integrateBondedLumps, below).
 //   store        forces into the contact lists, impulses into the warm-start cache.
 //
 // DIRECT mode (AGX manual: particle solve type agx::FrictionModel::DIRECT, with infinite friction and adhesion
@@ -141,6 +142,17 @@ class GranularStage {
   void directToParticles(GranularBodySystem& ps, const std::vector<SolverBodyState>& bodies) const;
   /// Velocities of the particle arrays into the appended bodies (after the sweeps, before the next direct solve).
   void particlesToDirect(const GranularBodySystem& ps, std::vector<SolverBodyState>& bodies) const;
+  // ---- DIRECT lump: rigid integration of a bonded lump's positions (issue 16, second pass) -------------------
+  /// Before integrate: each cluster of particles joined by this step's glued bonds (ppRest_, >= 3 particles)
+  /// moves by its rigid motion integrated exactly (centre of mass x += h v, rotation by the exact rotation of
+  /// angle h|w| about the cluster's angular velocity w = I^-1 L) plus h times each particle's non-rigid velocity
+  /// (x += h v on the rest); the rigid part of the velocities turns with the cluster. WHY: x += h v per particle
+  /// stretches a cluster turning at w by h^2 w^2 / 2 of its size each step (a pair 0.44 m apart in a lump
+  /// rocking at 0.44 rad/s: 1.2e-5 m a step, docs/terrain.md), which the bonds' SPOOK bias then pulls back over
+  /// several steps. Momentum, kinetic energy and the centre of mass's path are those of x += h v; a
+  /// straight chain (singular inertia) keeps x += h v.
+  /// `pp` is the particle-pair list buildRows read this step. integrate then skips the particles moved here.
+  void integrateBondedLumps(GranularBodySystem& ps, const std::vector<ParticleContact>& pp, Real h);
   /// Positions; non-finite particles are appended to outNonFinite (ids) with a message each.
   void integrate(GranularBodySystem& ps, Real h, std::vector<size_t>& outNonFinite, std::vector<std::string>& outMessages,
                  Real time);
@@ -259,6 +271,7 @@ class GranularStage {
   // gap (no longer a bond) forgets it.
   std::vector<std::pair<uint64_t, Real>> bondRest_;  // (pair key, rest overlap), sorted; from storeResults
   std::vector<Real> ppRest_;                         // [pp contacts] this step's rest, NaN: not a glued bond
+  std::vector<char> lumpMoved_;  // [dense] moved by integrateBondedLumps this step (integrate skips it)
   static bool anyGluedMaterial(const std::vector<PairParams>& ppParams, size_t K);
   Real bondRestOf(uint64_t key, Real depth, bool& found) const;  // the remembered rest of the pair, else `depth`
 };

@@ -29,6 +29,7 @@ void integrateMotion(SimulationState& s) {
   }
   if (s.granularStep) {
     const size_t before = s.report.messages.size();
+    s.particles.integrateBondedLumps(s.granular, s.particleCollider.getParticleParticleContacts(), h);
     s.particles.integrate(s.granular, h, s.report.nonFiniteParticles, s.report.messages, s.time);
     for (size_t k = before; k < s.report.messages.size(); ++k) Logger::error(s.report.messages[k]);
   }
