@@ -385,7 +385,8 @@
 // over the step's particle-geometry contacts and returns at once while the terrain has no particles.
 //
 // The shovel read-outs (digging force, fill) and the ground cutting force are below (TerrainShovelStats).
-// Not yet: the DIRECT lump dug and carried by a bucket drifts 1e-5 to 6e-5 m, not < 1e-6 (docs/terrain.md).
+// A DIRECT lump dug and carried by a bucket moves as one body: its glued clusters are integrated by their rigid
+// motion (GranularStage::integrateBondedLumps; docs/terrain.md, "The DIRECT lump carry").
 #pragma once
 
 #include <algorithm>
