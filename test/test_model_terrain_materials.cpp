@@ -345,6 +345,9 @@ TEST_CASE("particle friction solve type DIRECT: a dug lump carried by the bucket
   const DirectRun r = carryDirectLump(15);
   MESSAGE("lump " << r.lump << " particles, drift " << r.drift << " m, most pivots in a step " << r.maxPivots);
   CHECK(r.lump > 100);
-  CHECK(r.drift < 1e-6);
   CHECK(r.maxPivots == 0);
+  // Built without the direct solver (-DSCREE_WITH_SUITESPARSE=OFF) the DIRECT mode's bonds are swept by the
+  // particle stage like any other contact, so the lump is not rigid (measured 4.2e-2 m): the bound needs the
+  // direct solve of the bonds.
+  if (test::kHasDirectSolver) CHECK(r.drift < 1e-6);
 }
