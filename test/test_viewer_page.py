@@ -234,20 +234,27 @@ def run_checks(args, browser):
     n = page.eval("window.scree.recording.frames.length")
     check(n == frames, f"the page decoded {n} frames (the file has {frames})")
     # The page plays on the recording's clock (30 frames/s at speed 1, looping after the last frame), counting
-    # the frames it advances (stats.framesAdvanced, wraps included). Over a wall time T it advances at least 1
-    # frame and at most 30 T + 1 (it cannot run ahead of the wall clock; fewer when animation frames are late).
-    # On a loaded machine (ctest -j2 next to the simulation tests) Chromium can miss animation frames for a
-    # while, so after the first second the test waits up to 10 s more before calling the counter stuck.
+    # the frames it advances (stats.framesAdvanced, wraps included) and stamping the page time of the animation
+    # frame that last brought the count up to date (stats.clockTickMs). Between two such stamps t0 < t1 it advances
+    # at least 1 frame (over a second) and at most 30 (t1 - t0) + 1: its clock cannot run ahead of the page's
+    # own. The bound uses the page's stamps, not the test's wall clock: on a loaded machine an animation frame can
+    # be late, so the count read at the start may lag the wall clock by up to the page's 0.25 s stall cap and then
+    # catch up (seen in CI under the sanitizers: 37 frames in 1.01 s of test wall time). Chromium can also miss
+    # animation frames for a while, so after the first second the test waits up to 10 s more before calling the
+    # counter stuck.
+    read = "[window.scree.stats.framesAdvanced, window.scree.stats.clockTickMs]"
     w0 = time.time()
-    a0 = page.eval("window.scree.stats.framesAdvanced")
+    a0, t0 = page.eval(read)
     time.sleep(1.0)
-    a1 = page.eval("window.scree.stats.framesAdvanced")
+    a1, t1 = page.eval(read)
     while a1 == a0 and time.time() - w0 < 11.0:
         time.sleep(0.2)
-        a1 = page.eval("window.scree.stats.framesAdvanced")
-    wall = time.time() - w0
+        a1, t1 = page.eval(read)
     adv = a1 - a0
-    check(1 <= adv <= 30 * wall + 1, f"the frame counter advances while playing: {adv} frames in {wall:.2f} s")
+    span = (t1 - t0) / 1000.0 if t0 is not None and t1 is not None else float("nan")
+    check(adv >= 1 and adv <= 30 * span + 1,
+          f"the frame counter advances while playing: {adv} frames in {span:.3f} s of page time "
+          f"({time.time() - w0:.2f} s of test wall time)")
     fnow, shown = page.eval("[window.scree.frame, document.getElementById('frame').textContent]")
     check(shown.strip() == str(fnow), f"#frame shows the page's frame ({shown}, page state {fnow})")
     # Freeze the frame, draw it, then read positions and the screenshot of the same frame.

@@ -154,7 +154,7 @@
     window.addEventListener("resize", () => { s.resize(view.clientWidth, view.clientHeight); state.dirty = true; });
 
     // Measurement: wall time between animation frames and time spent updating + rendering, last 600 frames.
-    const stats = { intervals: [], workMs: [], rendered: 0, framesAdvanced: 0 };
+    const stats = { intervals: [], workMs: [], rendered: 0, framesAdvanced: 0, clockTickMs: null };
     const keep = (a, v) => { a.push(v); if (a.length > 600) a.shift(); };
     let lastRaf = null;
 
@@ -172,6 +172,7 @@
           if (state.clock > duration + rec.scene.frameInterval) state.clock = 0;  // loop
         }
         state.lastWall = now;
+        stats.clockTickMs = now;  // the page time at which framesAdvanced was last brought up to date
         const k = frameAt(state.clock);
         if (k !== state.frame) { stats.framesAdvanced += (k - state.frame + n) % n; state.frame = k; state.dirty = true; }
       }
