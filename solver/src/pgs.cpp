@@ -25,6 +25,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstddef>
 #include <cmath>
 
 #include "contact_law.h"
@@ -420,6 +421,10 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     r.blockSlot = -1;
   }
   if (blocks) {
+    // The compact manifold records (PgsSolver::iterate) describe last step's rows until iterate rebuilds them.
+    blocks->manifolds.clear();
+    blocks->points.clear();
+    blocks->plan.clear();
     size_t count = 0;
     for (size_t i = 0; i < rows.size(); ++i)
       if (rows[i].blockCount > 1 && rows[i].blockBegin == int32_t(i)) ++count;
@@ -516,14 +521,301 @@ static Real sweepRows(std::vector<ConstraintRow>& rows, std::vector<SolverBodySt
   return maxDelta;
 }
 
+// ---- issue 18 (compact contact arrays): compact manifold sweeps ----
+// DESIGN (docs/solver-internals.md "Compact manifold sweeps"): the serial sweeps visit a manifold contact
+// (contact_rows.h: [t1, t2, twist][normal block]) from one compact record, PgsBlocks::Manifold, and its points,
+// instead of seven 352-byte ConstraintRows and a Block: the friction rows' J and W and the block's operators as
+// 6-vectors [linear; angular] against the body's (v, w) read as one 6-vector, which SSE2 (the baseline x86-64
+// build) evaluates two doubles at a time, and the normal rows' block coordinates, compliances, impulses and
+// bounds in 48 bytes each. The law and the visiting order are those of solveUnit and solvePreparedBlock; the
+// sums run in another order, so impulses differ from the ConstraintRow path in the last bits. A block visit
+// that leaves a bound (tipping, separating) writes the manifold's normal impulses back, runs the ConstraintRow
+// path (solveClampedBlock, else row by row) and reads them again: rare, and one code path for the clamping. The
+// records are built at the start of PgsSolver::iterate (reused storage) and the impulses written back at its
+// end, so the result store keeps reading ConstraintRows; the shock pass solves a manifold support from the same
+// record (solveSupportCompact). PgsSolver::prepare clears the records, so a path that does not rebuild them
+// (the hybrid and coloured sweeps) never reads last step's.
+namespace {
+
+/// True when rows [i, i + 3 + n) are a manifold of the compact form (contact_rows.cpp builds them so).
+bool isCompactManifold(const std::vector<ConstraintRow>& rows, size_t i, int& nOut) {
+  if (i + 3 >= rows.size()) return false;
+  const ConstraintRow& t1 = rows[i];
+  const ConstraintRow& t2 = rows[i + 1];
+  const ConstraintRow& tw = rows[i + 2];
+  const ConstraintRow& n0 = rows[i + 3];
+  const int32_t nr = int32_t(i) + 3;
+  const int n = t1.normalCount;
+  if (n < 2 || n > kMaxNormalBlock || i + 3 + size_t(n) > rows.size()) return false;
+  if (n0.blockCount != n || n0.blockBegin != nr || n0.blockSlot < 0) return false;
+  const bool cone = t1.pairedRow == int32_t(i) + 1;
+  if (!cone && t1.pairedRow >= 0) return false;
+  for (const ConstraintRow* f : {&t1, &t2, &tw})
+    if (f->normalRow != nr || f->normalCount != n || f->bodyA != t1.bodyA || f->bodyB != t1.bodyB) return false;
+  if (t2.pairedRow >= 0 || tw.pairedRow >= 0) return false;
+  if (t1.mu != t2.mu) return false;
+  for (int k = 0; k < n; ++k) {
+    const ConstraintRow& r = rows[i + 3 + size_t(k)];
+    if (r.bodyA != t1.bodyA || r.bodyB != t1.bodyB || r.normalRow >= 0 || r.pairedRow >= 0) return false;
+  }
+  nOut = n;
+  return true;
+}
+
+/// The span of one ConstraintRow sweep unit starting at row i (a block, a cone pair or one row).
+size_t unitSpan(const std::vector<ConstraintRow>& rows, size_t i) {
+  if (rows[i].blockCount > 1) return size_t(rows[i].blockCount);
+  if (rows[i].pairedRow == int32_t(i) + 1) return 2;
+  return 1;
+}
+
+void buildCompact(const std::vector<ConstraintRow>& rows, PgsBlocks& pb) {
+  pb.manifolds.clear();
+  pb.points.clear();
+  pb.plan.clear();
+  size_t runBegin = 0;
+  for (size_t i = 0; i < rows.size();) {
+    int n = 0;
+    if (!isCompactManifold(rows, i, n)) {
+      i += unitSpan(rows, i);
+      continue;
+    }
+    if (runBegin < i) pb.plan.push_back({uint32_t(runBegin), uint32_t(i), -1});
+    PgsBlocks::Manifold m;
+    const ConstraintRow& t1 = rows[i];
+    m.a = t1.bodyA;
+    m.b = t1.bodyB;
+    m.row = uint32_t(i);
+    m.block = uint32_t(rows[i + 3].blockSlot);
+    m.point = uint32_t(pb.points.size());
+    m.n = n;
+    m.cone = t1.pairedRow == int32_t(i) + 1;
+    m.mu = t1.mu;
+    m.muTwist = rows[i + 2].mu;
+    for (int k = 0; k < 3; ++k) {
+      const ConstraintRow& r = rows[i + size_t(k)];
+      PgsBlocks::FrictionRow& f = m.f[k];
+      f.jA << r.jLinA, r.jAngA;
+      f.jB << r.jLinB, r.jAngB;
+      f.wA << r.mJLinA, r.mJAngA;
+      f.wB << r.mJLinB, r.mJAngB;
+      f.rhs = r.rhs;
+      f.e = r.e;
+      f.invDiag = r.invDiag;
+      f.lambda = r.lambda;
+    }
+    const PgsBlocks::Block& B = pb.blocks[m.block];
+    for (int a = 0; a < 3; ++a) {
+      m.gA[a] << B.gLinA[a], B.gAngA[a];
+      m.gB[a] << B.gLinB[a], B.gAngB[a];
+      m.wA[a] << B.wLinA[a], B.wAngA[a];
+      m.wB[a] << B.wLinB[a], B.wAngB[a];
+      m.dRhs[a] = B.dRhs[a];
+    }
+    for (int k = 0; k < 6; ++k) m.sInv[k] = B.sInv[0][k];
+    m.ok = B.ok[0];
+    m.axisU = B.axisU;
+    m.axisV = B.axisV;
+    for (int k = 0; k < n; ++k) {
+      const ConstraintRow& r = rows[i + 3 + size_t(k)];
+      pb.points.push_back({r.blockU, r.blockV, r.e, r.lambda, r.lo, r.hi});
+    }
+    pb.plan.push_back({uint32_t(i), uint32_t(i) + 3 + uint32_t(n), int32_t(pb.manifolds.size())});
+    pb.manifolds.push_back(m);
+    i += 3 + size_t(n);
+    runBegin = i;
+  }
+  if (runBegin < rows.size()) pb.plan.push_back({uint32_t(runBegin), uint32_t(rows.size()), -1});
+}
+
+void writeBackCompact(std::vector<ConstraintRow>& rows, const PgsBlocks& pb) {
+  for (const PgsBlocks::Manifold& m : pb.manifolds) {
+    for (int k = 0; k < 3; ++k) rows[m.row + uint32_t(k)].lambda = m.f[k].lambda;
+    for (int k = 0; k < m.n; ++k) rows[m.row + 3 + uint32_t(k)].lambda = pb.points[m.point + uint32_t(k)].lambda;
+  }
+}
+
+// A solver body's (v, w) as one Vec6 (SolverBodyState keeps w right after v).
+static_assert(offsetof(SolverBodyState, w) == 3 * sizeof(Real));
+using Vec6 = PgsBlocks::Vec6;
+inline Eigen::Map<Vec6> velocity(std::vector<SolverBodyState>& b, int32_t i) {
+  return Eigen::Map<Vec6>(b[size_t(i)].v.data());
+}
+inline Eigen::Map<const Vec6> velocity(const std::vector<SolverBodyState>& b, int32_t i) {
+  return Eigen::Map<const Vec6>(b[size_t(i)].v.data());
+}
+
+/// J v of a compact friction row.
+inline Real frictionVelocity(const PgsBlocks::FrictionRow& f, const PgsBlocks::Manifold& m,
+                             const std::vector<SolverBodyState>& b) {
+  Real jv = 0;
+  if (m.a >= 0) jv += f.jA.dot(velocity(b, m.a));
+  if (m.b >= 0) jv += f.jB.dot(velocity(b, m.b));
+  return jv;
+}
+
+/// v += W d of a compact friction row.
+inline void frictionImpulse(const PgsBlocks::FrictionRow& f, const PgsBlocks::Manifold& m, Real d,
+                            std::vector<SolverBodyState>& b) {
+  if (m.a >= 0) velocity(b, m.a) += f.wA * d;
+  if (m.b >= 0) velocity(b, m.b) += f.wB * d;
+}
+
+/// The friction rows' bound: mu times the sum of the manifold's positive normal impulses (boundingNormal).
+inline Real compactNormalSum(const PgsBlocks::Point* P, int n) {
+  Real sum = 0;
+  for (int k = 0; k < n; ++k) sum += std::max<Real>(P[k].lambda, 0);
+  return sum;
+}
+
+/// The friction rows of a compact manifold, forward (t1/t2, twist) or backward (twist, t2/t1).
+Real compactFriction(PgsBlocks::Manifold& m, const PgsBlocks::Point* P, std::vector<SolverBodyState>& bodies,
+                     bool forward) {
+  Real maxDelta = 0;
+  // The normal impulses do not change during the friction rows' visit: their sum is formed once.
+  const Real sumN = compactNormalSum(P, m.n);
+  auto scalar = [&](int k, Real mu) {
+    PgsBlocks::FrictionRow& f = m.f[k];
+    const Real lim = frictionLimit(mu, sumN);
+    const Real delta = (f.rhs - frictionVelocity(f, m, bodies) - f.e * f.lambda) * f.invDiag;
+    const Real nl = std::clamp(f.lambda + delta, -lim, lim);
+    const Real d = nl - f.lambda;
+    f.lambda = nl;
+    if (d != 0) frictionImpulse(f, m, d, bodies);
+    maxDelta = std::max(maxDelta, std::abs(d));
+  };
+  auto pair = [&]() {
+    PgsBlocks::FrictionRow& r = m.f[0];
+    PgsBlocks::FrictionRow& s = m.f[1];
+    Real d1 = (r.rhs - frictionVelocity(r, m, bodies) - r.e * r.lambda) * r.invDiag;
+    Real d2 = (s.rhs - frictionVelocity(s, m, bodies) - s.e * s.lambda) * s.invDiag;
+    Real l1 = r.lambda + d1, l2 = s.lambda + d2;
+    projectOntoDisc(l1, l2, frictionLimit(m.mu, sumN));
+    d1 = l1 - r.lambda;
+    d2 = l2 - s.lambda;
+    r.lambda = l1;
+    s.lambda = l2;
+    frictionImpulse(r, m, d1, bodies);
+    frictionImpulse(s, m, d2, bodies);
+    maxDelta = std::max(maxDelta, std::max(std::abs(d1), std::abs(d2)));
+  };
+  if (forward) {
+    if (m.cone) pair();
+    else {
+      scalar(0, m.mu);
+      scalar(1, m.mu);
+    }
+    scalar(2, m.muTwist);
+  } else {
+    scalar(2, m.muTwist);
+    if (m.cone) pair();
+    else {
+      scalar(1, m.mu);
+      scalar(0, m.mu);
+    }
+  }
+  return maxDelta;
+}
+
+}  // namespace
+
+/// The normal block of a compact manifold (solvePreparedBlock's law and arithmetic, both bodies free).
+static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<ConstraintRow>& rows,
+                         std::vector<SolverBodyState>& bodies, bool forward) {
+  PgsBlocks::Point* P = pb.points.data() + m.point;
+  const int n = m.n;
+  const int32_t ia = m.a, ib = m.b;
+  if (m.ok) {
+    Real b[3] = {m.dRhs[0], m.dRhs[1], m.dRhs[2]};
+    if (ia >= 0) {
+      const Vec6 V = velocity(bodies, ia);
+      for (int a = 0; a < 3; ++a) b[a] -= m.gA[a].dot(V);
+    }
+    if (ib >= 0) {
+      const Vec6 V = velocity(bodies, ib);
+      for (int a = 0; a < 3; ++a) b[a] -= m.gB[a].dot(V);
+    }
+    for (int i = 0; i < n; ++i) {
+      const Real el = P[i].e * P[i].lambda;
+      b[0] -= el;
+      b[1] -= el * P[i].u;
+      b[2] -= el * P[i].v;
+    }
+    if (!m.axisU) b[1] = 0;
+    if (!m.axisV) b[2] = 0;
+    const Real* Si = m.sInv;
+    Real dmu[3];
+    dmu[0] = Si[0] * b[0] + Si[1] * b[1] + Si[3] * b[2];
+    dmu[1] = Si[1] * b[0] + Si[2] * b[1] + Si[4] * b[2];
+    dmu[2] = Si[3] * b[0] + Si[4] * b[1] + Si[5] * b[2];
+    if (std::isfinite(dmu[0] + dmu[1] + dmu[2])) {
+      Real dl[kMaxNormalBlock];
+      bool inside = true;
+      for (int i = 0; i < n; ++i) {
+        dl[i] = dmu[0] + dmu[1] * P[i].u + dmu[2] * P[i].v;
+        const Real nl = P[i].lambda + dl[i];
+        inside &= nl >= P[i].lo && nl <= P[i].hi;
+      }
+      if (inside) {
+        Real maxD = 0;
+        for (int i = 0; i < n; ++i) {
+          P[i].lambda += dl[i];
+          maxD = std::max(maxD, std::abs(dl[i]));
+        }
+        if (ia >= 0) velocity(bodies, ia) += m.wA[0] * dmu[0] + m.wA[1] * dmu[1] + m.wA[2] * dmu[2];
+        if (ib >= 0) velocity(bodies, ib) += m.wB[0] * dmu[0] + m.wB[1] * dmu[1] + m.wB[2] * dmu[2];
+        return maxD;
+      }
+    }
+  }
+  // A bound is hit (or the block is singular): the ConstraintRow path on this manifold's normal rows.
+  const size_t first = m.row + 3;
+  for (int i = 0; i < n; ++i) rows[first + size_t(i)].lambda = P[i].lambda;
+  Real maxDelta = 0, d = 0;
+  if (solveNormalBlock(rows, bodies, first, -1, d, &pb)) {
+    maxDelta = d;
+  } else if (forward) {
+    for (size_t k = first; k < first + size_t(n); ++k) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
+  } else {
+    for (size_t k = first + size_t(n); k-- > first;) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
+  }
+  for (int i = 0; i < n; ++i) P[i].lambda = rows[first + size_t(i)].lambda;
+  return maxDelta;
+}
+
 Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
-                        const PgsBlocks* blocks) {
+                        PgsBlocks* blocks) {
   // Symmetric Gauss-Seidel: sweeps alternate forward and backward. On chains (joints, stacks) a one-way sweep
   // carries information one link per sweep in one direction only; alternating halves the propagation time and,
   // with SPOOK's stabilisation, keeps long stiff chains stable at the default iteration count where one-way
   // sweeps left enough residual to feed an oscillation.
   Real maxDelta = 0;
-  for (int it = 0; it < iterations; ++it) maxDelta = sweepRows(rows, bodies, 0, rows.size(), it % 2 == 0, blocks);
+  if (!blocks) {
+    for (int it = 0; it < iterations; ++it) maxDelta = sweepRows(rows, bodies, 0, rows.size(), it % 2 == 0, blocks);
+    return maxDelta;
+  }
+  buildCompact(rows, *blocks);
+  const std::vector<PgsBlocks::Unit>& plan = blocks->plan;
+  auto visit = [&](const PgsBlocks::Unit& u, bool forward) -> Real {
+    if (u.manifold < 0) return sweepRows(rows, bodies, u.begin, u.end, forward, blocks);
+    PgsBlocks::Manifold& m = blocks->manifolds[size_t(u.manifold)];
+    const PgsBlocks::Point* P = blocks->points.data() + m.point;
+    if (forward) {
+      const Real f = compactFriction(m, P, bodies, true);
+      return std::max(f, compactBlock(*blocks, m, rows, bodies, true));
+    }
+    const Real nd = compactBlock(*blocks, m, rows, bodies, false);
+    return std::max(nd, compactFriction(m, P, bodies, false));
+  };
+  for (int it = 0; it < iterations; ++it) {
+    maxDelta = 0;
+    if (it % 2 == 0) {
+      for (const PgsBlocks::Unit& u : plan) maxDelta = std::max(maxDelta, visit(u, true));
+    } else {
+      for (size_t k = plan.size(); k-- > 0;) maxDelta = std::max(maxDelta, visit(plan[k], false));
+    }
+  }
+  writeBackCompact(rows, *blocks);
   return maxDelta;
 }
 
@@ -670,6 +962,105 @@ bool PgsSolver::solveSupportExactly(std::vector<ConstraintRow>& rows, std::vecto
   return true;
 }
 
+// The support solve above on a compact manifold record (PgsSolver::iterate): the same system, its operators
+// read as 6-vectors, the impulses read from and written to the ConstraintRows (the shock pass's state).
+namespace {
+bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                         const PgsSolver::ShockRange& sr, const PgsBlocks& pb, const PgsBlocks::Manifold& m) {
+  constexpr int kM = 6;
+  const int n = m.n;
+  if (sr.begin != m.row || sr.count != uint32_t(3 + n)) return false;
+  const bool freeA = sr.frozen != 0;
+  const int32_t fb = freeA ? m.a : m.b;
+  if (fb < 0) return false;
+  const PgsBlocks::Point* P = pb.points.data() + m.point;
+  ConstraintRow* F = rows.data() + m.row;
+  ConstraintRow* R = F + 3;
+  const Vec6* G[kM];
+  const Vec6* W[kM];
+  for (int a = 0; a < 3; ++a) {
+    G[a] = freeA ? &m.gA[a] : &m.gB[a];
+    W[a] = freeA ? &m.wA[a] : &m.wB[a];
+    G[3 + a] = freeA ? &m.f[a].jA : &m.f[a].jB;
+    W[3 + a] = freeA ? &m.f[a].wA : &m.f[a].wB;
+  }
+  Eigen::Matrix<Real, kM, kM> K;
+  for (int a = 0; a < kM; ++a)
+    for (int c = 0; c <= a; ++c) K(a, c) = K(c, a) = G[a]->dot(*W[c]);
+  // Regularisation: the block's D E D^T, the friction rows' own e.
+  Real dE[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  Real b[kM];
+  for (int a = 0; a < 3; ++a) b[a] = m.dRhs[a];
+  for (int i = 0; i < n; ++i) {
+    const Real D[3] = {1.0, P[i].u, P[i].v};
+    const Real e = P[i].e, el = e * R[i].lambda;
+    for (int a = 0; a < 3; ++a) {
+      b[a] -= D[a] * el;
+      for (int c = 0; c < 3; ++c) dE[a][c] += D[a] * e * D[c];
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+    for (int c = 0; c < 3; ++c) K(a, c) += dE[a][c];
+  for (int k = 0; k < 3; ++k) K(3 + k, 3 + k) += m.f[k].e;
+  // Residuals (velocities of both bodies, as in the sweeps).
+  if (m.a >= 0) {
+    const Vec6 V = velocity(bodies, m.a);
+    for (int a = 0; a < 3; ++a) b[a] -= m.gA[a].dot(V);
+    for (int k = 0; k < 3; ++k) b[3 + k] = m.f[k].rhs - m.f[k].jA.dot(V);
+  } else {
+    for (int k = 0; k < 3; ++k) b[3 + k] = m.f[k].rhs;
+  }
+  if (m.b >= 0) {
+    const Vec6 V = velocity(bodies, m.b);
+    for (int a = 0; a < 3; ++a) b[a] -= m.gB[a].dot(V);
+    for (int k = 0; k < 3; ++k) b[3 + k] -= m.f[k].jB.dot(V);
+  }
+  for (int k = 0; k < 3; ++k) b[3 + k] -= m.f[k].e * F[k].lambda;
+  // A degenerate axis carries nothing (as in the block).
+  for (int a = 1; a < 3; ++a)
+    if (!(a == 1 ? m.axisU : m.axisV)) {
+      K.row(a).setZero();
+      K.col(a).setZero();
+      K(a, a) = 1;
+      b[a] = 0;
+    }
+  const Eigen::LLT<Eigen::Matrix<Real, kM, kM>> llt(K);
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::Matrix<Real, kM, 1> x = llt.solve(Eigen::Map<const Eigen::Matrix<Real, kM, 1>>(b));
+  if (!x.allFinite()) return false;
+  // Bounds: the new normal impulses, then the friction inside mu times their new sum.
+  Real nl[kMaxNormalBlock];
+  Real sumN = 0;
+  for (int i = 0; i < n; ++i) {
+    nl[i] = R[i].lambda + x[0] + x[1] * P[i].u + x[2] * P[i].v;
+    if (nl[i] < P[i].lo || nl[i] > P[i].hi) return false;
+    sumN += std::max<Real>(nl[i], 0);
+  }
+  Real fl[3];
+  for (int k = 0; k < 3; ++k) fl[k] = F[k].lambda + x[3 + k];
+  const Real lim = frictionLimit(m.mu, sumN);
+  if (m.cone) {
+    if (fl[0] * fl[0] + fl[1] * fl[1] > lim * lim) return false;
+  } else if (std::abs(fl[0]) > lim || std::abs(fl[1]) > lim) {
+    return false;
+  }
+  if (std::abs(fl[2]) > frictionLimit(m.muTwist, sumN)) return false;
+  for (int i = 0; i < n; ++i) R[i].lambda = nl[i];
+  for (int k = 0; k < 3; ++k) F[k].lambda = fl[k];
+  Vec6 dV = Vec6::Zero();
+  for (int a = 0; a < kM; ++a) dV += *W[a] * x[a];
+  velocity(bodies, fb) += dV;
+  return true;
+}
+
+/// The compact manifold whose rows start at `row`, or null (records sorted by row).
+const PgsBlocks::Manifold* compactAt(const PgsBlocks& pb, uint32_t row) {
+  auto it = std::lower_bound(pb.manifolds.begin(), pb.manifolds.end(), row,
+                             [](const PgsBlocks::Manifold& m, uint32_t r) { return m.row < r; });
+  return it != pb.manifolds.end() && it->row == row ? &*it : nullptr;
+}
+}  // namespace
+
 void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                           const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks) {
   auto solveFrozen = [&](ConstraintRow& r, int frozen, Real lo, Real hi) -> Real {
@@ -745,7 +1136,14 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
     }
   };
   for (const ShockRange& sr : ranges) {
-    if (blocks && solveSupportExactly(rows, bodies, sr, *blocks)) continue;
+    if (blocks) {
+      // DESIGN (issue 18, compact contact arrays): a manifold support reads the compact record the sweeps used.
+      if (const PgsBlocks::Manifold* m = compactAt(*blocks, sr.begin)) {
+        if (solveSupportCompact(rows, bodies, sr, *blocks, *m)) continue;
+      } else if (solveSupportExactly(rows, bodies, sr, *blocks)) {
+        continue;
+      }
+    }
     for (int sweep = 0; sweep < maxSweeps; ++sweep) {
       Real change = 0, scale = 0;
       sweepRange(sr, change, scale);

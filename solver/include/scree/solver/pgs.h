@@ -45,6 +45,46 @@ struct PgsBlocks {
     bool axisU, axisV;
   };
   std::vector<Block> blocks;
+
+  // ---- issue 18 (compact contact arrays; pgs.cpp "Compact manifold sweeps", docs/solver-internals.md) ----
+  /// A body's (v, w) or a row's Jacobian on one body, [linear; angular]: six doubles that SSE2 handles as three
+  /// packets of two, where two Vec3 take six scalar operations.
+  using Vec6 = Eigen::Matrix<Real, 6, 1>;
+  /// One friction row of a manifold ([t1, t2, twist] at its centre, contact_rows.h) as the sweeps read it: J and
+  /// W = M^-1 J^T on each body.
+  struct FrictionRow {
+    Vec6 jA, jB, wA, wB;
+    Real rhs, e, invDiag, lambda;
+  };
+  /// A manifold contact (its three friction rows and its normal block) swept as one unit: every datum a visit
+  /// reads lies in this record and its points (one 48-byte Point per normal row); the block operators are the
+  /// Block's (both bodies free), in Vec6 form.
+  struct Manifold {
+    FrictionRow f[3];
+    Vec6 gA[3], gB[3], wA[3], wB[3];  ///< Block::gLin/gAng and wLin/wAng per coordinate
+    Real dRhs[3], sInv[6];            ///< Block::dRhs, Block::sInv[0]
+    int32_t a, b;                     ///< solver bodies (-1: static)
+    uint32_t row;                     ///< ConstraintRow of t1; t2 = row + 1, twist = row + 2, normals from row + 3
+    uint32_t block;                   ///< slot in blocks
+    uint32_t point;                   ///< first of its n entries in points
+    int32_t n;                        ///< normal rows
+    bool cone;                        ///< t1, t2 a projected-cone pair (else two scaled-box rows)
+    bool ok, axisU, axisV;            ///< Block::ok[0], axisU, axisV
+    Real mu, muTwist;                 ///< friction coefficients of the pair and the twist (ConstraintRow::mu)
+  };
+  /// A normal row of a manifold block: its block coordinates, compliance, impulse and bounds.
+  struct Point {
+    Real u, v, e, lambda, lo, hi;
+  };
+  /// The serial sweep's visiting order: a compact manifold (manifold >= 0) or the ConstraintRows [begin, end)
+  /// swept row by row (joints, per-point contacts, anything not of the manifold form).
+  struct Unit {
+    uint32_t begin, end;
+    int32_t manifold;
+  };
+  std::vector<Manifold> manifolds;
+  std::vector<Point> points;
+  std::vector<Unit> plan;
 };
 
 // ---- issue 18 (sweep scheduling): graph-coloured sweeps (pgs.cpp, docs/solver-internals.md "Coloured sweeps") ----
@@ -85,8 +125,10 @@ class PgsSolver {
                       PgsBlocks* blocks = nullptr);
   /// `iterations` sweeps over all rows in order. Returns the largest |delta lambda| of the last sweep. `blocks`
   /// must be the one given to prepare (or null).
+  /// With `blocks`, manifold contacts are swept from compact copies (PgsBlocks::Manifold) built at entry and
+  /// their impulses written back to the rows at exit.
   static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
-                      const PgsBlocks* blocks = nullptr);
+                      PgsBlocks* blocks = nullptr);
   /// Colours `colouring.units` (PgsColouring) for the given rows and bodies; call after prepare, every step.
   static void colour(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
                      PgsColouring& colouring);
