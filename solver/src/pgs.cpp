@@ -161,7 +161,7 @@ static bool solveClampedBlock(ConstraintRow* R, int n, const Real* resid, Real* 
 static inline Real blockD(const ConstraintRow& r, int a) { return a == 0 ? 1.0 : a == 1 ? r.blockU : r.blockV; }
 
 // Builds the constant operators of the block whose first row is R (PgsBlocks::Block).
-static void buildBlock(const ConstraintRow* R, PgsBlocks::Block& B) {
+static void buildBlock(const ConstraintRow* R, const std::vector<SolverBodyState>& bodies, PgsBlocks::Block& B) {
   const int n = R[0].blockCount;
   Real su = 0, sv = 0;
   for (int i = 0; i < n; ++i) {
@@ -170,9 +170,11 @@ static void buildBlock(const ConstraintRow* R, PgsBlocks::Block& B) {
   }
   B.axisU = su > 0;
   B.axisV = sv > 0;
+  const bool hasA = R[0].bodyA >= 0, hasB = R[0].bodyB >= 0;
+  const SolverBodyState& bA = hasA ? bodies[size_t(R[0].bodyA)] : kStatic;
+  const SolverBodyState& bB = hasB ? bodies[size_t(R[0].bodyB)] : kStatic;
   for (int a = 0; a < 3; ++a) {
     B.gLinA[a] = B.gAngA[a] = B.gLinB[a] = B.gAngB[a] = Vec3::Zero();
-    B.wLinA[a] = B.wAngA[a] = B.wLinB[a] = B.wAngB[a] = Vec3::Zero();
     B.dRhs[a] = 0;
     for (int i = 0; i < n; ++i) {
       const Real d = blockD(R[i], a);
@@ -181,14 +183,14 @@ static void buildBlock(const ConstraintRow* R, PgsBlocks::Block& B) {
       B.gAngA[a] += d * R[i].jAngA;
       B.gLinB[a] += d * R[i].jLinB;
       B.gAngB[a] += d * R[i].jAngB;
-      B.wLinA[a] += d * R[i].mJLinA;
-      B.wAngA[a] += d * R[i].mJAngA;
-      B.wLinB[a] += d * R[i].mJLinB;
-      B.wAngB[a] += d * R[i].mJAngB;
       B.dRhs[a] += d * R[i].rhs;
     }
+    // W_a = M^-1 G_a^T from G_a (one product per body instead of summing the rows' M^-1 J_i^T; issue 18).
+    B.wLinA[a] = bA.invMass * B.gLinA[a];
+    B.wAngA[a] = bA.invInertia * B.gAngA[a];
+    B.wLinB[a] = bB.invMass * B.gLinB[a];
+    B.wAngB[a] = bB.invInertia * B.gAngB[a];
   }
-  const bool hasA = R[0].bodyA >= 0, hasB = R[0].bodyB >= 0;
   // S = D (K + E) D^T = G_a . W_c (over the free bodies) + sum_i D_ai e_i D_ci: the parts of body A, of body B
   // and of E once (symmetric), then summed per configuration.
   Real SA[3][3], SB[3][3], SE[3][3];
@@ -432,7 +434,7 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     size_t slot = 0;
     for (size_t i = 0; i < rows.size(); ++i)
       if (rows[i].blockCount > 1 && rows[i].blockBegin == int32_t(i)) {
-        buildBlock(rows.data() + i, blocks->blocks[slot]);
+        buildBlock(rows.data() + i, bodies, blocks->blocks[slot]);
         rows[i].blockSlot = int32_t(slot++);
       }
   }
