@@ -647,22 +647,6 @@ inline Eigen::Map<const Vec6> velocity(const std::vector<SolverBodyState>& b, in
   return Eigen::Map<const Vec6>(b[size_t(i)].v.data());
 }
 
-/// J v of a compact friction row.
-inline Real frictionVelocity(const PgsBlocks::FrictionRow& f, const PgsBlocks::Manifold& m,
-                             const std::vector<SolverBodyState>& b) {
-  Real jv = 0;
-  if (m.a >= 0) jv += f.jA.dot(velocity(b, m.a));
-  if (m.b >= 0) jv += f.jB.dot(velocity(b, m.b));
-  return jv;
-}
-
-/// v += W d of a compact friction row.
-inline void frictionImpulse(const PgsBlocks::FrictionRow& f, const PgsBlocks::Manifold& m, Real d,
-                            std::vector<SolverBodyState>& b) {
-  if (m.a >= 0) velocity(b, m.a) += f.wA * d;
-  if (m.b >= 0) velocity(b, m.b) += f.wB * d;
-}
-
 /// The friction rows' bound: mu times the sum of the manifold's positive normal impulses (boundingNormal).
 inline Real compactNormalSum(const PgsBlocks::Point* P, int n) {
   Real sum = 0;
@@ -670,35 +654,52 @@ inline Real compactNormalSum(const PgsBlocks::Point* P, int n) {
   return sum;
 }
 
-/// The friction rows of a compact manifold, forward (t1/t2, twist) or backward (twist, t2/t1).
-Real compactFriction(PgsBlocks::Manifold& m, const PgsBlocks::Point* P, std::vector<SolverBodyState>& bodies,
-                     bool forward) {
+/// The two bodies' velocities during one manifold visit. Every row of a manifold acts on the same two bodies, so
+/// a visit reads their (v, w) once into registers and stores them once; a static side reads as zero and is never
+/// stored (its W is zero, so the rows leave its local copy at zero).
+struct VisitBodies {
+  Vec6 a, b;
+  bool hasA, hasB;
+  VisitBodies(const PgsBlocks::Manifold& m, const std::vector<SolverBodyState>& bodies)
+      : hasA(m.a >= 0), hasB(m.b >= 0) {
+    a = hasA ? Vec6(velocity(bodies, m.a)) : Vec6::Zero();
+    b = hasB ? Vec6(velocity(bodies, m.b)) : Vec6::Zero();
+  }
+  void store(const PgsBlocks::Manifold& m, std::vector<SolverBodyState>& bodies) const {
+    if (hasA) velocity(bodies, m.a) = a;
+    if (hasB) velocity(bodies, m.b) = b;
+  }
+};
+
+/// The friction rows of a compact manifold, forward (t1/t2, twist) or backward (twist, t2/t1); solveUnit's law.
+Real compactFriction(PgsBlocks::Manifold& m, const PgsBlocks::Point* P, VisitBodies& V, bool forward) {
   Real maxDelta = 0;
   // The normal impulses do not change during the friction rows' visit: their sum is formed once.
   const Real sumN = compactNormalSum(P, m.n);
   auto scalar = [&](int k, Real mu) {
     PgsBlocks::FrictionRow& f = m.f[k];
     const Real lim = frictionLimit(mu, sumN);
-    const Real delta = (f.rhs - frictionVelocity(f, m, bodies) - f.e * f.lambda) * f.invDiag;
+    const Real delta = (f.rhs - (f.jA.dot(V.a) + f.jB.dot(V.b)) - f.e * f.lambda) * f.invDiag;
     const Real nl = std::clamp(f.lambda + delta, -lim, lim);
     const Real d = nl - f.lambda;
     f.lambda = nl;
-    if (d != 0) frictionImpulse(f, m, d, bodies);
+    V.a += f.wA * d;
+    V.b += f.wB * d;
     maxDelta = std::max(maxDelta, std::abs(d));
   };
   auto pair = [&]() {
     PgsBlocks::FrictionRow& r = m.f[0];
     PgsBlocks::FrictionRow& s = m.f[1];
-    Real d1 = (r.rhs - frictionVelocity(r, m, bodies) - r.e * r.lambda) * r.invDiag;
-    Real d2 = (s.rhs - frictionVelocity(s, m, bodies) - s.e * s.lambda) * s.invDiag;
+    Real d1 = (r.rhs - (r.jA.dot(V.a) + r.jB.dot(V.b)) - r.e * r.lambda) * r.invDiag;
+    Real d2 = (s.rhs - (s.jA.dot(V.a) + s.jB.dot(V.b)) - s.e * s.lambda) * s.invDiag;
     Real l1 = r.lambda + d1, l2 = s.lambda + d2;
     projectOntoDisc(l1, l2, frictionLimit(m.mu, sumN));
     d1 = l1 - r.lambda;
     d2 = l2 - s.lambda;
     r.lambda = l1;
     s.lambda = l2;
-    frictionImpulse(r, m, d1, bodies);
-    frictionImpulse(s, m, d2, bodies);
+    V.a += r.wA * d1 + s.wA * d2;
+    V.b += r.wB * d1 + s.wB * d2;
     maxDelta = std::max(maxDelta, std::max(std::abs(d1), std::abs(d2)));
   };
   if (forward) {
@@ -721,22 +722,14 @@ Real compactFriction(PgsBlocks::Manifold& m, const PgsBlocks::Point* P, std::vec
 
 }  // namespace
 
-/// The normal block of a compact manifold (solvePreparedBlock's law and arithmetic, both bodies free).
+/// The normal block of a compact manifold (solvePreparedBlock's law, both bodies free).
 static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<ConstraintRow>& rows,
-                         std::vector<SolverBodyState>& bodies, bool forward) {
+                         std::vector<SolverBodyState>& bodies, VisitBodies& V, bool forward) {
   PgsBlocks::Point* P = pb.points.data() + m.point;
   const int n = m.n;
-  const int32_t ia = m.a, ib = m.b;
   if (m.ok) {
-    Real b[3] = {m.dRhs[0], m.dRhs[1], m.dRhs[2]};
-    if (ia >= 0) {
-      const Vec6 V = velocity(bodies, ia);
-      for (int a = 0; a < 3; ++a) b[a] -= m.gA[a].dot(V);
-    }
-    if (ib >= 0) {
-      const Vec6 V = velocity(bodies, ib);
-      for (int a = 0; a < 3; ++a) b[a] -= m.gB[a].dot(V);
-    }
+    Real b[3];
+    for (int a = 0; a < 3; ++a) b[a] = m.dRhs[a] - (m.gA[a].dot(V.a) + m.gB[a].dot(V.b));
     for (int i = 0; i < n; ++i) {
       const Real el = P[i].e * P[i].lambda;
       b[0] -= el;
@@ -764,13 +757,15 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
           P[i].lambda += dl[i];
           maxD = std::max(maxD, std::abs(dl[i]));
         }
-        if (ia >= 0) velocity(bodies, ia) += m.wA[0] * dmu[0] + m.wA[1] * dmu[1] + m.wA[2] * dmu[2];
-        if (ib >= 0) velocity(bodies, ib) += m.wB[0] * dmu[0] + m.wB[1] * dmu[1] + m.wB[2] * dmu[2];
+        V.a += m.wA[0] * dmu[0] + m.wA[1] * dmu[1] + m.wA[2] * dmu[2];
+        V.b += m.wB[0] * dmu[0] + m.wB[1] * dmu[1] + m.wB[2] * dmu[2];
         return maxD;
       }
     }
   }
-  // A bound is hit (or the block is singular): the ConstraintRow path on this manifold's normal rows.
+  // A bound is hit (or the block is singular): the ConstraintRow path on this manifold's normal rows, on the
+  // stored velocities.
+  V.store(m, bodies);
   const size_t first = m.row + 3;
   for (int i = 0; i < n; ++i) rows[first + size_t(i)].lambda = P[i].lambda;
   Real maxDelta = 0, d = 0;
@@ -782,6 +777,7 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
     for (size_t k = first + size_t(n); k-- > first;) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
   }
   for (int i = 0; i < n; ++i) P[i].lambda = rows[first + size_t(i)].lambda;
+  V = VisitBodies(m, bodies);
   return maxDelta;
 }
 
@@ -802,12 +798,17 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     if (u.manifold < 0) return sweepRows(rows, bodies, u.begin, u.end, forward, blocks);
     PgsBlocks::Manifold& m = blocks->manifolds[size_t(u.manifold)];
     const PgsBlocks::Point* P = blocks->points.data() + m.point;
+    VisitBodies V(m, bodies);
+    Real d;
     if (forward) {
-      const Real f = compactFriction(m, P, bodies, true);
-      return std::max(f, compactBlock(*blocks, m, rows, bodies, true));
+      d = compactFriction(m, P, V, true);
+      d = std::max(d, compactBlock(*blocks, m, rows, bodies, V, true));
+    } else {
+      d = compactBlock(*blocks, m, rows, bodies, V, false);
+      d = std::max(d, compactFriction(m, P, V, false));
     }
-    const Real nd = compactBlock(*blocks, m, rows, bodies, false);
-    return std::max(nd, compactFriction(m, P, bodies, false));
+    V.store(m, bodies);
+    return d;
   };
   for (int it = 0; it < iterations; ++it) {
     maxDelta = 0;
