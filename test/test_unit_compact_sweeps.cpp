@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Compact manifold sweeps (pgs.cpp "Compact manifold sweeps", PgsBlocks::Manifold; docs/solver-internals.md):
 // the serial sweeps with a PgsBlocks read a manifold contact from a compact record instead of its ConstraintRows.
 // The law and the visiting order are the ConstraintRow sweeps', so both must give the same impulses and
