@@ -160,6 +160,14 @@ class GranularStage {
   void storeResults(const GranularBodySystem& ps, const ParticleContactLists& contacts, Real h);
   size_t numUnits() const { return units_.size(); }
   int numSlabs() const { return numSlabs_; }
+  // ---- Vectorised centred sweep (issue 16, trench speed; see "Four-wide sweep" in the .cpp) ----------------
+  /// Whether this CPU runs the four-wide (AVX2) sweep of centred units; false: every unit is swept by the scalar
+  /// code in unit order. The results are bit-identical either way (the .cpp says why).
+  static bool vectorSweepAvailable();
+  /// Test and measurement switch (all stages of the process): false forces the scalar sweep. Default true.
+  static void setVectorSweepEnabled(bool on);
+  /// Units swept four at a time in the last step's sweeps (0 on the scalar path).
+  size_t numVectorUnits() const { return 4 * packets_.size(); }
 
  private:
   // One contact point between particle a and particle b or a geometry (its rigid body index `body`, -1 none).
@@ -274,6 +282,36 @@ class GranularStage {
   std::vector<char> lumpMoved_;  // [dense] moved by integrateBondedLumps this step (integrate skips it)
   static bool anyGluedMaterial(const std::vector<PairParams>& ppParams, size_t K);
   Real bondRestOf(uint64_t key, Real depth, bool& found) const;  // the remembered rest of the pair, else `depth`
+
+  // ---- Four-wide sweep of centred units (issue 16, trench speed; the .cpp's "Four-wide sweep") ---------------
+ public:
+  // Four centred units with 8 distinct particles, lane-interleaved (field f of lane j at f[f][j]): the unit data
+  // the sweep reads, the particles' inverse masses and inertias, and the impulses (the authoritative copy while
+  // packed_, written back to the units by unpack()).
+  enum PacketField : int {
+    kNx, kNy, kNz, kT1x, kT1y, kT1z, kT2x, kT2y, kT2z, kSigma, kLa, kLb, kKN, kKT1, kKT2, kRhsN, kEN, kLoN, kET,
+    kMu, kRhsT1, kRhsT2, kRollMu, kKR, kImA, kImB, kIiA, kIiB, kInvIA, kInvIB, kLN, kLT1, kLT2, kLR1, kLR2,
+    kNumPacketFields
+  };
+  struct alignas(32) Packet {
+    uint32_t a[4], b[4];  // first: the kernel reads them first (then the particles' velocities)
+    uint32_t unit[4], pad[4];
+    double f[kNumPacketFields][4];
+  };
+
+ private:
+  std::vector<Packet> packets_;
+  // Per slab, the sweep order as items: >= 0 a unit of units_ (scalar), < 0 the packet -1 - item.
+  std::vector<int32_t> items_;
+  std::vector<uint32_t> itemStart_;          // [numSlabs + 1] ranges into items_
+  std::vector<uint32_t> levelOf_, lastLevel_, stampOf_, levelCount_, levelOrder_;
+  std::vector<char> packable_;
+  uint32_t stamp_ = 0;
+  bool scheduleStale_ = true;  // buildRows made new units: the schedule and packets are rebuilt at the next sweep
+  bool packed_ = false;        // the packets hold the current impulses of their units
+  void buildSchedule(const GranularBodySystem& ps);
+  void pack(const GranularBodySystem& ps);  // unit data (and impulses) into packets_
+  void unpack();                            // packets' impulses back into units_
 };
 
 }  // namespace scree::detail
