@@ -4,6 +4,7 @@
 #include "granular_stage.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <sstream>
@@ -126,6 +127,7 @@ void radixSortBy(std::vector<T>& v, std::vector<T>& tmp, int bits, KeyOf digitKe
 // units. The kernel is chosen at run time (__builtin_cpu_supports), so the build runs on any x86-64; elsewhere,
 // or without AVX2, the scalar sweep runs in unit order. test_unit_granular_system compares both bit for bit.
 bool gVectorSweepEnabled = true;
+std::atomic<uint64_t> gPackedUnits{0};  // packedUnitsTotal
 // Packets per kernel call (1-4): independent packets of one level solved together overlap their latencies.
 constexpr size_t kPacketRun = SCREE_PACKET_RUN;
 
@@ -248,8 +250,9 @@ SCREE_AVX2 inline void stageFriction(GranularStage::Packet& p, LaneState& s) {
            Lz = add(mul(la, s.waz), mul(lb, s.wbz));
   const P4 vt1 = sub(dot3(t1x, t1y, t1z, dvx, dvy, dvz), mul(sigma, dot3(Lx, Ly, Lz, t2x, t2y, t2z)));
   const P4 vt2 = add(dot3(t2x, t2y, t2z, dvx, dvy, dvz), mul(sigma, dot3(Lx, Ly, Lz, t1x, t1y, t1z)));
-  P4 l1 = add(lT1, mul(sub(sub(F(G::kRhsT1), vt1), mul(eT, lT1)), F(G::kKT1)));
-  P4 l2 = add(lT2, mul(sub(sub(F(G::kRhsT2), vt2), mul(eT, lT2)), F(G::kKT2)));
+  const P4 kT = F(G::kKT);
+  P4 l1 = add(lT1, mul(sub(sub(zero, vt1), mul(eT, lT1)), kT));  // rhsT1 = +0 (see packable)
+  P4 l2 = add(lT2, mul(sub(sub(zero, vt2), mul(eT, lT2)), kT));
   projectDisc4(l1, l2, lim);
   const P4 bounded = _mm256_cmp_pd(lim, zero, _CMP_NEQ_UQ);  // a zero bound leaves no friction
   l1 = sel(zero, l1, bounded);
@@ -265,7 +268,8 @@ SCREE_AVX2 inline void stageFriction(GranularStage::Packet& p, LaneState& s) {
            pz = add(mul(d1, t1z), mul(d2, t2z));
   const P4 qx = mul(sigma, sub(mul(d1, t2x), mul(d2, t1x))), qy = mul(sigma, sub(mul(d1, t2y), mul(d2, t1y))),
            qz = mul(sigma, sub(mul(d1, t2z), mul(d2, t1z)));  // n x P
-  const P4 ima = F(G::kImA), imb = F(G::kImB), iia = F(G::kIiA), iib = F(G::kIiB);
+  const P4 ima = F(G::kImA), imb = F(G::kImB);
+  const P4 iia = mul(F(G::kInvIA), la), iib = mul(F(G::kInvIB), lb);  // as solveCentred's
   s.vax = sel(s.vax, add(s.vax, mul(ima, px)), moved);
   s.vay = sel(s.vay, add(s.vay, mul(ima, py)), moved);
   s.vaz = sel(s.vaz, add(s.vaz, mul(ima, pz)), moved);
@@ -525,10 +529,12 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     const bool isPP = k < pp.size();
     const ParticleContact& c = isPP ? pp[k] : pg[k - pp.size()];
     if (!isPP && c.sensor) continue;
-    Unit& u = units_[unitDest_[isPP ? k : pgUnit[k - pp.size()]]];
+    const uint32_t dest = unitDest_[isPP ? k : pgUnit[k - pp.size()]];
+    Unit& u = units_[dest];
     u = Unit{};
     u.a = c.a;
     u.b = isPP ? c.b : -1;
+    schedUnit_[dest] = {u.a, u.b, 0};  // packable: set below once the unit is complete
     u.body = isPP ? -1 : pgBody[k - pp.size()];
     u.src = uint32_t(isPP ? k : k - pp.size());
     u.n = c.normal;
@@ -674,6 +680,7 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
       u.lR1 = sgn * ce->rolling.dot(u.t1);
       u.lR2 = sgn * ce->rolling.dot(u.t2);
     }
+    schedUnit_[dest].packable = packable(u);
   }
 }
 
@@ -720,6 +727,7 @@ void GranularStage::partition(const GranularBodySystem& ps, Real cellSize) {
   auto& cursor = slabCursor_;
   cursor.assign(slabStart_.begin(), slabStart_.end() - 1);
   units_.resize(nu);
+  schedUnit_.assign(nu, SchedUnit{});
   unitDest_.resize(nu);
   for (size_t k = 0; k < nu; ++k) unitDest_[k] = cursor[slabOf_[k]]++;
   numSlabs_ = numSlabs;
@@ -1003,6 +1011,15 @@ bool GranularStage::vectorSweepAvailable() { return gVectorSweepEnabled && cpuHa
 
 void GranularStage::setVectorSweepEnabled(bool on) { gVectorSweepEnabled = on; }
 
+uint64_t GranularStage::packedUnitsTotal() { return gPackedUnits.load(); }
+
+bool GranularStage::packable(const Unit& u) {
+  // +0 friction targets (no surface velocity) and equal tangent gains: the packet's reduced fields.
+  const bool plainT = std::bit_cast<uint64_t>(u.rhsT1) == 0 && std::bit_cast<uint64_t>(u.rhsT2) == 0;
+  return u.centred && u.b >= 0 && u.kN != 0 && std::isfinite(u.mu) && std::isfinite(u.rollMu) && plainT &&
+         u.kT1 == u.kT2;
+}
+
 void GranularStage::buildSchedule(const GranularBodySystem& ps) {
   // Per slab: each unit's dependency level, the units in (level, unit) order (a counting sort), and per level
   // the packable units in packets of four (see "Four-wide sweep"). Depends on the units only, never on the
@@ -1017,9 +1034,6 @@ void GranularStage::buildSchedule(const GranularBodySystem& ps) {
     stampOf_.assign(n, 0);
     stamp_ = 0;
   }
-  auto packable = [&](const Unit& u) {
-    return u.centred && u.b >= 0 && u.kN != 0 && std::isfinite(u.mu) && std::isfinite(u.rollMu);
-  };
   uint32_t group[4];
   int grouped = 0;
   for (int sl = 0; sl < S; ++sl) {
@@ -1034,12 +1048,11 @@ void GranularStage::buildSchedule(const GranularBodySystem& ps) {
     uint32_t top = 0;
     auto levelAt = [&](size_t i) { return stampOf_[i] == stamp_ ? lastLevel_[i] : 0u; };
     for (uint32_t k = b0; k < b1; ++k) {
-      const Unit& u = units_[k];
+      const SchedUnit& u = schedUnit_[k];  // 12 bytes a unit, written by buildRows (not the 312 of units_)
       uint32_t L = levelAt(u.a);
       if (u.b >= 0) L = std::max(L, levelAt(size_t(u.b)));
       ++L;
-      // Read here, in unit order (the grouping below visits the units in level order, scattered over units_).
-      packable_[k - b0] = packable(u);
+      packable_[k - b0] = char(u.packable);
       levelOf_[k - b0] = L;
       top = std::max(top, L);
       lastLevel_[u.a] = L;
@@ -1086,6 +1099,7 @@ void GranularStage::buildSchedule(const GranularBodySystem& ps) {
     }
   }
   itemStart_[size_t(S)] = uint32_t(items_.size());
+  gPackedUnits += 4 * packets_.size();
 }
 
 void GranularStage::pack(const GranularBodySystem& ps) {
@@ -1119,21 +1133,16 @@ void GranularStage::pack(const GranularBodySystem& ps) {
       f[kLa][j] = u.la;
       f[kLb][j] = u.lb;
       f[kKN][j] = u.kN;
-      f[kKT1][j] = u.kT1;
-      f[kKT2][j] = u.kT2;
+      f[kKT][j] = u.kT1;
       f[kRhsN][j] = u.rhsN;
       f[kEN][j] = u.eN;
       f[kLoN][j] = u.loN;
       f[kET][j] = u.eT;
       f[kMu][j] = u.mu;
-      f[kRhsT1][j] = u.rhsT1;
-      f[kRhsT2][j] = u.rhsT2;
       f[kRollMu][j] = u.rollMu;
       f[kKR][j] = u.kR;
       f[kImA][j] = invM[a];
       f[kImB][j] = invM[b];
-      f[kIiA][j] = invInertia_[a] * u.la;  // as solveCentred's iia, iib
-      f[kIiB][j] = invInertia_[b] * u.lb;
       f[kInvIA][j] = invInertia_[a];
       f[kInvIB][j] = invInertia_[b];
       f[kLN][j] = u.lN;

@@ -166,8 +166,9 @@ class GranularStage {
   static bool vectorSweepAvailable();
   /// Test and measurement switch (all stages of the process): false forces the scalar sweep. Default true.
   static void setVectorSweepEnabled(bool on);
-  /// Units swept four at a time in the last step's sweeps (0 on the scalar path).
-  size_t numVectorUnits() const { return 4 * packets_.size(); }
+  /// Units put into packets since the process started, over all stages (a test's evidence that the four-wide
+  /// path ran).
+  static uint64_t packedUnitsTotal();
 
  private:
   // One contact point between particle a and particle b or a geometry (its rigid body index `body`, -1 none).
@@ -286,12 +287,12 @@ class GranularStage {
   // ---- Four-wide sweep of centred units (issue 16, trench speed; the .cpp's "Four-wide sweep") ---------------
  public:
   // Four centred units with 8 distinct particles, lane-interleaved (field f of lane j at f[f][j]): the unit data
-  // the sweep reads, the particles' inverse masses and inertias, and the impulses (the authoritative copy while
+  // the sweep reads (a centred unit's two tangent gains are equal: one kKT; packed units have no surface
+  // velocity, so the friction targets are zero), the particles' inverse masses and inertias, and the impulses (the authoritative copy while
   // packed_, written back to the units by unpack()).
   enum PacketField : int {
-    kNx, kNy, kNz, kT1x, kT1y, kT1z, kT2x, kT2y, kT2z, kSigma, kLa, kLb, kKN, kKT1, kKT2, kRhsN, kEN, kLoN, kET,
-    kMu, kRhsT1, kRhsT2, kRollMu, kKR, kImA, kImB, kIiA, kIiB, kInvIA, kInvIB, kLN, kLT1, kLT2, kLR1, kLR2,
-    kNumPacketFields
+    kNx, kNy, kNz, kT1x, kT1y, kT1z, kT2x, kT2y, kT2z, kSigma, kLa, kLb, kKN, kKT, kRhsN, kEN, kLoN, kET, kMu,
+    kRollMu, kKR, kImA, kImB, kInvIA, kInvIB, kLN, kLT1, kLT2, kLR1, kLR2, kNumPacketFields
   };
   struct alignas(32) Packet {
     uint32_t a[4], b[4];  // first: the kernel reads them first (then the particles' velocities)
@@ -309,6 +310,14 @@ class GranularStage {
   uint32_t stamp_ = 0;
   bool scheduleStale_ = true;  // buildRows made new units: the schedule and packets are rebuilt at the next sweep
   bool packed_ = false;        // the packets hold the current impulses of their units
+  // What the schedule needs of each unit (in units_ order), written by buildRows.
+  struct SchedUnit {
+    uint32_t a = 0;
+    int32_t b = -1;
+    uint32_t packable = 0;
+  };
+  std::vector<SchedUnit> schedUnit_;
+  static bool packable(const Unit& u);  // may go into a packet (see the .cpp)
   void buildSchedule(const GranularBodySystem& ps);
   void pack(const GranularBodySystem& ps);  // unit data (and impulses) into packets_
   void unpack();                            // packets' impulses back into units_
