@@ -301,7 +301,8 @@ class GranularStage {
   };
 
  private:
-  std::vector<Packet> packets_;
+  std::vector<Packet> packets_;  // [0, numPackets_) in use
+  size_t numPackets_ = 0;
   // Per slab, the sweep order as items: >= 0 a unit of units_ (scalar), < 0 the packet -1 - item.
   std::vector<int32_t> items_;
   std::vector<uint32_t> itemStart_;          // [numSlabs + 1] ranges into items_
