@@ -30,6 +30,10 @@
 //                the point) are swept by solveCentred, the same law without the normal row's zero angular terms
 //                and with the tangents' angular parts as multiples of the basis (about half the arithmetic;
 //                docs/terrain.md, "Digging cost").
+//                Four-wide sweep (where the CPU has AVX2): each slab's units are swept in dependency-level order
+//                and centred units of one level, which share no particle, four at a time in SIMD lanes; the
+//                result is the scalar sweep's bit for bit (the .cpp's "Four-wide sweep" says why; memory, not
+//                arithmetic, bounds it, so the packets are prefetched).
 //   integrate    x += h v for live particles; a particle whose velocity or position turns non-finite is
 //                reported by id, keeps its last position and is stopped. Clusters joined by glued DIRECT bonds
 //                move by their exactly integrated rigid motion first (integrateBondedLumps, below).
