@@ -4,9 +4,18 @@
 #include "granular_stage.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <sstream>
+
+#ifndef SCREE_PACKET_RUN
+#define SCREE_PACKET_RUN 2
+#endif
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#endif
 
 #include "contact_law.h"
 #include "scree/solver/direct.h"
@@ -101,6 +110,244 @@ void radixSortBy(std::vector<T>& v, std::vector<T>& tmp, int bits, KeyOf digitKe
   if (src != &v) v.swap(tmp);
 }
 
+// ---- Four-wide sweep ---------------------------------------------------------------------------------------
+// Issue 16, trench speed (docs/terrain.md, "Digging cost", sixth round). The centred Gauss-Seidel update
+// (solveCentred<-1>) was 41 % of the trench bench, bound by each unit's own arithmetic. Four centred units that
+// share no particle are solved at once, one per lane of 256-bit AVX2 registers, in double precision.
+// WHY the results are bit-identical to the scalar sweep in unit order:
+//  - order: each slab's units get a dependency level (one more than the highest level of the slab's earlier
+//    units that share a particle with it) and are swept level by level. Units of one level share no particle,
+//    so they commute exactly; any two units sharing a particle keep their order (reversed, with the level order,
+//    in backward sweeps). A level is cut into packets of four centred units plus single (scalar) units.
+//  - arithmetic: each lane performs the scalar code's IEEE operations in the same order (the dot products as
+//    (x + y) + z, as Eigen evaluates them here); the kernel is compiled for AVX2 without FMA, so nothing is
+//    contracted; std::max and the branches become compare-and-blend with the same predicates (a skipped update
+//    is a blend that keeps the old value, so not even the sign of a zero changes).
+// Packets exclude units with infinite friction or rolling bounds (the glued DIRECT bonds) and non-centred
+// units. The kernel is chosen at run time (__builtin_cpu_supports), so the build runs on any x86-64; elsewhere,
+// or without AVX2, the scalar sweep runs in unit order. test_unit_granular_system compares both bit for bit.
+bool gVectorSweepEnabled = true;
+std::atomic<uint64_t> gPackedUnits{0};  // packedUnitsTotal
+// Packets per kernel call (1-4): independent packets of one level solved together overlap their latencies.
+constexpr size_t kPacketRun = SCREE_PACKET_RUN;
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define SCREE_SWEEP_AVX2 1
+#define SCREE_AVX2 __attribute__((target("avx2")))
+using P4 = __m256d;
+
+SCREE_AVX2 inline void load3(const Vec3* arr, const uint32_t* idx, P4& X, P4& Y, P4& Z) {
+  const double* p0 = arr[idx[0]].data();
+  const double* p1 = arr[idx[1]].data();
+  const double* p2 = arr[idx[2]].data();
+  const double* p3 = arr[idx[3]].data();
+  const __m128d r0 = _mm_loadu_pd(p0), r1 = _mm_loadu_pd(p1), r2 = _mm_loadu_pd(p2), r3 = _mm_loadu_pd(p3);
+  X = _mm256_set_m128d(_mm_unpacklo_pd(r2, r3), _mm_unpacklo_pd(r0, r1));
+  Y = _mm256_set_m128d(_mm_unpackhi_pd(r2, r3), _mm_unpackhi_pd(r0, r1));
+  Z = _mm256_set_pd(p3[2], p2[2], p1[2], p0[2]);
+}
+
+SCREE_AVX2 inline void store3(Vec3* arr, const uint32_t* idx, P4 X, P4 Y, P4 Z) {
+  const __m128d x01 = _mm256_castpd256_pd128(X), x23 = _mm256_extractf128_pd(X, 1);
+  const __m128d y01 = _mm256_castpd256_pd128(Y), y23 = _mm256_extractf128_pd(Y, 1);
+  alignas(32) double z[4];
+  _mm256_store_pd(z, Z);
+  double* p0 = arr[idx[0]].data();
+  double* p1 = arr[idx[1]].data();
+  double* p2 = arr[idx[2]].data();
+  double* p3 = arr[idx[3]].data();
+  _mm_storeu_pd(p0, _mm_unpacklo_pd(x01, y01));
+  _mm_storeu_pd(p1, _mm_unpackhi_pd(x01, y01));
+  _mm_storeu_pd(p2, _mm_unpacklo_pd(x23, y23));
+  _mm_storeu_pd(p3, _mm_unpackhi_pd(x23, y23));
+  p0[2] = z[0];
+  p1[2] = z[1];
+  p2[2] = z[2];
+  p3[2] = z[3];
+}
+
+SCREE_AVX2 inline P4 add(P4 a, P4 b) { return _mm256_add_pd(a, b); }
+SCREE_AVX2 inline P4 sub(P4 a, P4 b) { return _mm256_sub_pd(a, b); }
+SCREE_AVX2 inline P4 mul(P4 a, P4 b) { return _mm256_mul_pd(a, b); }
+/// mask ? b : a
+SCREE_AVX2 inline P4 sel(P4 a, P4 b, P4 mask) { return _mm256_blendv_pd(a, b, mask); }
+/// (x0 y0 + x1 y1) + x2 y2, as Eigen's Vec3::dot in the scalar code
+SCREE_AVX2 inline P4 dot3(P4 ax, P4 ay, P4 az, P4 bx, P4 by, P4 bz) {
+  return add(add(mul(ax, bx), mul(ay, by)), mul(az, bz));
+}
+/// projectOntoDisc (contact_law.h), lane by lane.
+SCREE_AVX2 inline void projectDisc4(P4& l1, P4& l2, P4 lim) {
+  const P4 zero = _mm256_setzero_pd();
+  const P4 mag2 = add(mul(l1, l1), mul(l2, l2));
+  const P4 over = _mm256_cmp_pd(mag2, mul(lim, lim), _CMP_GT_OQ);
+  const P4 mag = _mm256_sqrt_pd(mag2);
+  const P4 s = sel(zero, _mm256_div_pd(lim, mag), _mm256_cmp_pd(mag, zero, _CMP_GT_OQ));
+  l1 = sel(l1, mul(l1, s), over);
+  l2 = sel(l2, mul(l2, s), over);
+}
+
+/// The state of one packet in the kernel: its particles' velocities and what the later updates need.
+struct LaneState {
+  P4 vax, vay, vaz, vbx, vby, vbz, wax, way, waz, wbx, wby, wbz;
+  P4 lNpos;  // max(lambda_n, 0) after the normal update
+  P4 absD;   // |delta lambda_n|
+};
+
+SCREE_AVX2 inline void stageLoad(const GranularStage::Packet& p, const Vec3* v, const Vec3* w, LaneState& s) {
+  load3(v, p.a, s.vax, s.vay, s.vaz);
+  load3(v, p.b, s.vbx, s.vby, s.vbz);
+  load3(w, p.a, s.wax, s.way, s.waz);
+  load3(w, p.b, s.wbx, s.wby, s.wbz);
+}
+
+SCREE_AVX2 inline void stageStore(const GranularStage::Packet& p, Vec3* v, Vec3* w, const LaneState& s) {
+  store3(v, p.a, s.vax, s.vay, s.vaz);
+  store3(v, p.b, s.vbx, s.vby, s.vbz);
+  store3(w, p.a, s.wax, s.way, s.waz);
+  store3(w, p.b, s.wbx, s.wby, s.wbz);
+}
+
+/// The normal row of solveCentred<-1>, lane by lane.
+SCREE_AVX2 inline void stageNormal(GranularStage::Packet& p, LaneState& s) {
+  using G = GranularStage;
+  auto F = [&](int k) SCREE_AVX2 { return _mm256_load_pd(p.f[k]); };
+  const P4 zero = _mm256_setzero_pd();
+  const P4 nx = F(G::kNx), ny = F(G::kNy), nz = F(G::kNz);
+  const P4 ima = F(G::kImA), imb = F(G::kImB);
+  const P4 lN = F(G::kLN);
+  const P4 vn = dot3(nx, ny, nz, sub(s.vax, s.vbx), sub(s.vay, s.vby), sub(s.vaz, s.vbz));
+  P4 nl = add(lN, mul(sub(sub(F(G::kRhsN), vn), mul(F(G::kEN), lN)), F(G::kKN)));
+  const P4 lo = F(G::kLoN);
+  nl = sel(nl, lo, _mm256_cmp_pd(nl, lo, _CMP_LT_OQ));  // std::max(nl, lo)
+  const P4 d = sub(nl, lN);
+  _mm256_store_pd(p.f[G::kLN], nl);
+  const P4 moved = _mm256_cmp_pd(d, zero, _CMP_NEQ_UQ);
+  const P4 px = mul(d, nx), py = mul(d, ny), pz = mul(d, nz);
+  s.vax = sel(s.vax, add(s.vax, mul(ima, px)), moved);
+  s.vay = sel(s.vay, add(s.vay, mul(ima, py)), moved);
+  s.vaz = sel(s.vaz, add(s.vaz, mul(ima, pz)), moved);
+  s.vbx = sel(s.vbx, sub(s.vbx, mul(imb, px)), moved);
+  s.vby = sel(s.vby, sub(s.vby, mul(imb, py)), moved);
+  s.vbz = sel(s.vbz, sub(s.vbz, mul(imb, pz)), moved);
+  s.lNpos = sel(nl, zero, _mm256_cmp_pd(nl, zero, _CMP_LT_OQ));  // std::max(lN, 0)
+  s.absD = _mm256_andnot_pd(_mm256_set1_pd(-0.0), d);
+}
+
+/// The friction rows (packets hold finite mu only: frictionLimit = mu max(lN, 0)).
+SCREE_AVX2 inline void stageFriction(GranularStage::Packet& p, LaneState& s) {
+  using G = GranularStage;
+  auto F = [&](int k) SCREE_AVX2 { return _mm256_load_pd(p.f[k]); };
+  const P4 zero = _mm256_setzero_pd();
+  const P4 t1x = F(G::kT1x), t1y = F(G::kT1y), t1z = F(G::kT1z);
+  const P4 t2x = F(G::kT2x), t2y = F(G::kT2y), t2z = F(G::kT2z);
+  const P4 eT = F(G::kET);
+  const P4 mu = F(G::kMu);
+  const P4 lim = mul(mu, s.lNpos);
+  const P4 lT1 = F(G::kLT1), lT2 = F(G::kLT2);
+  const P4 la = F(G::kLa), lb = F(G::kLb), sigma = F(G::kSigma);
+  const P4 dvx = sub(s.vax, s.vbx), dvy = sub(s.vay, s.vby), dvz = sub(s.vaz, s.vbz);
+  const P4 Lx = add(mul(la, s.wax), mul(lb, s.wbx)), Ly = add(mul(la, s.way), mul(lb, s.wby)),
+           Lz = add(mul(la, s.waz), mul(lb, s.wbz));
+  const P4 vt1 = sub(dot3(t1x, t1y, t1z, dvx, dvy, dvz), mul(sigma, dot3(Lx, Ly, Lz, t2x, t2y, t2z)));
+  const P4 vt2 = add(dot3(t2x, t2y, t2z, dvx, dvy, dvz), mul(sigma, dot3(Lx, Ly, Lz, t1x, t1y, t1z)));
+  const P4 kT = F(G::kKT);
+  P4 l1 = add(lT1, mul(sub(sub(zero, vt1), mul(eT, lT1)), kT));  // rhsT1 = +0 (see packable)
+  P4 l2 = add(lT2, mul(sub(sub(zero, vt2), mul(eT, lT2)), kT));
+  projectDisc4(l1, l2, lim);
+  const P4 bounded = _mm256_cmp_pd(lim, zero, _CMP_NEQ_UQ);  // a zero bound leaves no friction
+  l1 = sel(zero, l1, bounded);
+  l2 = sel(zero, l2, bounded);
+  const P4 has = _mm256_cmp_pd(mu, zero, _CMP_GT_OQ);  // mu > 0, else no friction rows at all
+  l1 = sel(lT1, l1, has);
+  l2 = sel(lT2, l2, has);
+  const P4 d1 = sub(l1, lT1), d2 = sub(l2, lT2);
+  _mm256_store_pd(p.f[G::kLT1], l1);
+  _mm256_store_pd(p.f[G::kLT2], l2);
+  const P4 moved = _mm256_or_pd(_mm256_cmp_pd(d1, zero, _CMP_NEQ_UQ), _mm256_cmp_pd(d2, zero, _CMP_NEQ_UQ));
+  const P4 px = add(mul(d1, t1x), mul(d2, t2x)), py = add(mul(d1, t1y), mul(d2, t2y)),
+           pz = add(mul(d1, t1z), mul(d2, t2z));
+  const P4 qx = mul(sigma, sub(mul(d1, t2x), mul(d2, t1x))), qy = mul(sigma, sub(mul(d1, t2y), mul(d2, t1y))),
+           qz = mul(sigma, sub(mul(d1, t2z), mul(d2, t1z)));  // n x P
+  const P4 ima = F(G::kImA), imb = F(G::kImB);
+  const P4 iia = mul(F(G::kInvIA), la), iib = mul(F(G::kInvIB), lb);  // as solveCentred's
+  s.vax = sel(s.vax, add(s.vax, mul(ima, px)), moved);
+  s.vay = sel(s.vay, add(s.vay, mul(ima, py)), moved);
+  s.vaz = sel(s.vaz, add(s.vaz, mul(ima, pz)), moved);
+  s.wax = sel(s.wax, sub(s.wax, mul(iia, qx)), moved);
+  s.way = sel(s.way, sub(s.way, mul(iia, qy)), moved);
+  s.waz = sel(s.waz, sub(s.waz, mul(iia, qz)), moved);
+  s.vbx = sel(s.vbx, sub(s.vbx, mul(imb, px)), moved);
+  s.vby = sel(s.vby, sub(s.vby, mul(imb, py)), moved);
+  s.vbz = sel(s.vbz, sub(s.vbz, mul(imb, pz)), moved);
+  s.wbx = sel(s.wbx, sub(s.wbx, mul(iib, qx)), moved);
+  s.wby = sel(s.wby, sub(s.wby, mul(iib, qy)), moved);
+  s.wbz = sel(s.wbz, sub(s.wbz, mul(iib, qz)), moved);
+}
+
+/// The rolling rows (rollingImpulse; packets hold finite rollMu only).
+SCREE_AVX2 inline void stageRolling(GranularStage::Packet& p, LaneState& s) {
+  using G = GranularStage;
+  auto F = [&](int k) SCREE_AVX2 { return _mm256_load_pd(p.f[k]); };
+  const P4 zero = _mm256_setzero_pd();
+  const P4 signBit = _mm256_set1_pd(-0.0);
+  const P4 t1x = F(G::kT1x), t1y = F(G::kT1y), t1z = F(G::kT1z);
+  const P4 t2x = F(G::kT2x), t2y = F(G::kT2y), t2z = F(G::kT2z);
+  const P4 eT = F(G::kET);
+  const P4 rollMu = F(G::kRollMu), kR = F(G::kKR);
+  const P4 has = _mm256_and_pd(_mm256_cmp_pd(rollMu, zero, _CMP_GT_OQ), _mm256_cmp_pd(kR, zero, _CMP_GT_OQ));
+  const P4 lim = mul(rollMu, s.lNpos);
+  const P4 lR1 = F(G::kLR1), lR2 = F(G::kLR2);
+  const P4 rx = sub(s.wax, s.wbx), ry = sub(s.way, s.wby), rz = sub(s.waz, s.wbz);
+  const P4 neg1 = _mm256_xor_pd(dot3(t1x, t1y, t1z, rx, ry, rz), signBit);
+  const P4 neg2 = _mm256_xor_pd(dot3(t2x, t2y, t2z, rx, ry, rz), signBit);
+  P4 l1 = add(lR1, mul(sub(neg1, mul(eT, lR1)), kR));
+  P4 l2 = add(lR2, mul(sub(neg2, mul(eT, lR2)), kR));
+  projectDisc4(l1, l2, lim);
+  const P4 bounded = _mm256_cmp_pd(lim, zero, _CMP_NEQ_UQ);
+  l1 = sel(zero, l1, bounded);
+  l2 = sel(zero, l2, bounded);
+  const P4 c1 = sub(l1, lR1), c2 = sub(l2, lR2);
+  const P4 tx = add(mul(c1, t1x), mul(c2, t2x)), ty = add(mul(c1, t1y), mul(c2, t2y)),
+           tz = add(mul(c1, t1z), mul(c2, t2z));
+  _mm256_store_pd(p.f[G::kLR1], sel(lR1, l1, has));
+  _mm256_store_pd(p.f[G::kLR2], sel(lR2, l2, has));
+  const P4 iA = F(G::kInvIA), iB = F(G::kInvIB);
+  s.wax = sel(s.wax, add(s.wax, mul(iA, tx)), has);
+  s.way = sel(s.way, add(s.way, mul(iA, ty)), has);
+  s.waz = sel(s.waz, add(s.waz, mul(iA, tz)), has);
+  s.wbx = sel(s.wbx, sub(s.wbx, mul(iB, tx)), has);
+  s.wby = sel(s.wby, sub(s.wby, mul(iB, ty)), has);
+  s.wbz = sel(s.wbz, sub(s.wbz, mul(iB, tz)), has);
+}
+
+/// solveCentred<-1> of kN packets at once (4 kN units whose 8 kN particles are all distinct): each stage runs
+/// for every packet before the next stage, so the packets' independent dependency chains (square root and
+/// division in each disc projection) overlap in the core. Returns the largest |delta lambda_n|.
+template <int kN>
+SCREE_AVX2 __attribute__((noinline)) Real solvePacketsAvx2(GranularStage::Packet* p, Vec3* v, Vec3* w) {
+  LaneState s[kN];
+  for (int q = 0; q < kN; ++q) stageLoad(p[q], v, w, s[q]);
+  for (int q = 0; q < kN; ++q) stageNormal(p[q], s[q]);
+  for (int q = 0; q < kN; ++q) stageFriction(p[q], s[q]);
+  for (int q = 0; q < kN; ++q) stageRolling(p[q], s[q]);
+  for (int q = 0; q < kN; ++q) stageStore(p[q], v, w, s[q]);
+  P4 m = s[0].absD;
+  for (int q = 1; q < kN; ++q) m = _mm256_max_pd(m, s[q].absD);
+  alignas(32) double ad[4];
+  _mm256_store_pd(ad, m);
+  return std::max(std::max(ad[0], ad[1]), std::max(ad[2], ad[3]));
+}
+
+bool cpuHasAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+}
+#else
+bool cpuHasAvx2() { return false; }
+template <int kN>
+Real solvePacketsAvx2(GranularStage::Packet*, Vec3*, Vec3*) { return 0; }
+#endif
+
 }  // namespace
 
 GranularStage::PairParams GranularStage::makeParams(const SurfaceParameters& s, const FrictionModel* fm, Real h) {
@@ -170,6 +417,8 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
   const auto& matIdx = ps.materialIndices();
   const auto& matTable = ps.getMaterialTable();
 
+  scheduleStale_ = true;  // new units: the four-wide sweep's schedule and packets are rebuilt
+  packed_ = false;
   invInertia_.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const Real m = ps.masses()[i];
@@ -280,10 +529,12 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     const bool isPP = k < pp.size();
     const ParticleContact& c = isPP ? pp[k] : pg[k - pp.size()];
     if (!isPP && c.sensor) continue;
-    Unit& u = units_[unitDest_[isPP ? k : pgUnit[k - pp.size()]]];
+    const uint32_t dest = unitDest_[isPP ? k : pgUnit[k - pp.size()]];
+    Unit& u = units_[dest];
     u = Unit{};
     u.a = c.a;
     u.b = isPP ? c.b : -1;
+    schedUnit_[dest] = {u.a, u.b, 0};  // packable: set below once the unit is complete
     u.body = isPP ? -1 : pgBody[k - pp.size()];
     u.src = uint32_t(isPP ? k : k - pp.size());
     u.n = c.normal;
@@ -429,6 +680,7 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
       u.lR1 = sgn * ce->rolling.dot(u.t1);
       u.lR2 = sgn * ce->rolling.dot(u.t2);
     }
+    schedUnit_[dest].packable = packable(u);
   }
 }
 
@@ -475,6 +727,7 @@ void GranularStage::partition(const GranularBodySystem& ps, Real cellSize) {
   auto& cursor = slabCursor_;
   cursor.assign(slabStart_.begin(), slabStart_.end() - 1);
   units_.resize(nu);
+  schedUnit_.assign(nu, SchedUnit{});
   unitDest_.resize(nu);
   for (size_t k = 0; k < nu; ++k) unitDest_[k] = cursor[slabOf_[k]]++;
   numSlabs_ = numSlabs;
@@ -675,10 +928,68 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
     return md;
   };
   const int S = numSlabs_;
+  // Four-wide sweep (see "Four-wide sweep" above): each slab's units in level order, centred ones in packets.
+  const bool vec = gVectorSweepEnabled && cpuHasAvx2() && !units_.empty();
+  if (vec) {
+    if (scheduleStale_) {
+      buildSchedule(ps);
+      scheduleStale_ = false;
+      packed_ = false;
+    }
+    if (!packed_) pack(ps);
+  } else {
+    unpack();
+    numPackets_ = 0;
+    scheduleStale_ = true;
+  }
+  auto runSlab = [&](int sl) {
+    if (!vec) return runRange(slabStart_[size_t(sl)], slabStart_[size_t(sl) + 1]);
+    Real md = 0;
+    const uint32_t i0 = itemStart_[size_t(sl)], i1 = itemStart_[size_t(sl) + 1];
+    auto item = [&](int32_t it) SCREE_UNIT_INLINE {
+      if (it >= 0) one(units_[size_t(it)], md);
+      else {
+        const uint32_t code = uint32_t(-1 - it);
+        Packet* p = &packets_[code >> 2];
+        switch (code & 3) {
+          case 0: md = std::max(md, solvePacketsAvx2<1>(p, v.data(), w.data())); break;
+          case 1: md = std::max(md, solvePacketsAvx2<2>(p, v.data(), w.data())); break;
+          case 2: md = std::max(md, solvePacketsAvx2<3>(p, v.data(), w.data())); break;
+          default: md = std::max(md, solvePacketsAvx2<4>(p, v.data(), w.data())); break;
+        }
+      }
+    };
+    // The packets stream from memory (about 290 bytes a unit): the packets (or the unit) of the item kAheadItems ahead
+    // are fetched while this one is solved (no effect on results).
+    constexpr uint32_t kAheadItems = 3;
+    auto fetch = [&](int32_t it) SCREE_UNIT_INLINE {
+      if (it >= 0) {  // a single unit, visited in level order (scattered over units_)
+        const char* c = reinterpret_cast<const char*>(&units_[size_t(it)]);
+        for (size_t off = 0; off < sizeof(Unit); off += 64) __builtin_prefetch(c + off);
+        __builtin_prefetch(c + sizeof(Unit) - 1);
+        return;
+      }
+      const uint32_t code = uint32_t(-1 - it);
+      const char* c = reinterpret_cast<const char*>(&packets_[code >> 2]);
+      const size_t bytes = ((code & 3) + 1) * sizeof(Packet);
+      for (size_t off = 0; off < bytes; off += 64) __builtin_prefetch(c + off);
+    };
+    if (!backward)
+      for (uint32_t i = i0; i < i1; ++i) {
+        if (i + kAheadItems < i1) fetch(items_[i + kAheadItems]);
+        item(items_[i]);
+      }
+    else
+      for (uint32_t i = i1; i-- > i0;) {
+        if (i >= i0 + kAheadItems) fetch(items_[i - kAheadItems]);
+        item(items_[i]);
+      }
+    return md;
+  };
   const uint32_t serialBegin = slabStart_[size_t(S)], serialEnd = slabStart_[size_t(S) + 1];
   if (backward) maxDelta = std::max(maxDelta, runRange(serialBegin, serialEnd));
   if (S == 1) {
-    maxDelta = std::max(maxDelta, runRange(slabStart_[0], slabStart_[1]));
+    maxDelta = std::max(maxDelta, runSlab(0));
   } else {
     // Two phases (even slabs, then odd; reversed when sweeping backward), each slab a serial Gauss-Seidel run:
     // slabs of one phase share no particle, so which thread runs which slab does not change any bit.
@@ -688,7 +999,7 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
 #pragma omp for schedule(dynamic, 1) reduction(max : maxDelta)
       for (int j = 0; j < (S - parity + 1) / 2; ++j) {
         const int sl = backward ? S - 1 - ((S - 1 - parity) % 2) - 2 * j : parity + 2 * j;
-        maxDelta = std::max(maxDelta, runRange(slabStart_[size_t(sl)], slabStart_[size_t(sl) + 1]));
+        maxDelta = std::max(maxDelta, runSlab(sl));
       }
     }
   }
@@ -696,8 +1007,173 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
   return maxDelta;
 }
 
+bool GranularStage::vectorSweepAvailable() { return gVectorSweepEnabled && cpuHasAvx2(); }
+
+void GranularStage::setVectorSweepEnabled(bool on) { gVectorSweepEnabled = on; }
+
+uint64_t GranularStage::packedUnitsTotal() { return gPackedUnits.load(); }
+
+bool GranularStage::packable(const Unit& u) {
+  // +0 friction targets (no surface velocity) and equal tangent gains: the packet's reduced fields.
+  const bool plainT = std::bit_cast<uint64_t>(u.rhsT1) == 0 && std::bit_cast<uint64_t>(u.rhsT2) == 0;
+  return u.centred && u.b >= 0 && u.kN != 0 && std::isfinite(u.mu) && std::isfinite(u.rollMu) && plainT &&
+         u.kT1 == u.kT2;
+}
+
+void GranularStage::buildSchedule(const GranularBodySystem& ps) {
+  // Per slab: each unit's dependency level, the units in (level, unit) order (a counting sort), and per level
+  // the packable units in packets of four (see "Four-wide sweep"). Depends on the units only, never on the
+  // number of threads.
+  const size_t n = ps.size();
+  const int S = numSlabs_;
+  numPackets_ = 0;
+  items_.clear();
+  itemStart_.assign(size_t(S) + 1, 0);
+  if (lastLevel_.size() < n) {
+    lastLevel_.resize(n);
+    stampOf_.assign(n, 0);
+    stamp_ = 0;
+  }
+  uint32_t group[4];
+  int grouped = 0;
+  for (int sl = 0; sl < S; ++sl) {
+    itemStart_[size_t(sl)] = uint32_t(items_.size());
+    const uint32_t b0 = slabStart_[size_t(sl)], b1 = slabStart_[size_t(sl) + 1];
+    if (++stamp_ == 0) {  // wrapped: forget all stamps
+      std::fill(stampOf_.begin(), stampOf_.end(), 0);
+      stamp_ = 1;
+    }
+    levelOf_.resize(b1 - b0);
+    packable_.resize(b1 - b0);
+    uint32_t top = 0;
+    auto levelAt = [&](size_t i) { return stampOf_[i] == stamp_ ? lastLevel_[i] : 0u; };
+    for (uint32_t k = b0; k < b1; ++k) {
+      const SchedUnit& u = schedUnit_[k];  // 12 bytes a unit, written by buildRows (not the 312 of units_)
+      uint32_t L = levelAt(u.a);
+      if (u.b >= 0) L = std::max(L, levelAt(size_t(u.b)));
+      ++L;
+      packable_[k - b0] = char(u.packable);
+      levelOf_[k - b0] = L;
+      top = std::max(top, L);
+      lastLevel_[u.a] = L;
+      stampOf_[u.a] = stamp_;
+      if (u.b >= 0) {
+        lastLevel_[size_t(u.b)] = L;
+        stampOf_[size_t(u.b)] = stamp_;
+      }
+    }
+    levelCount_.assign(size_t(top) + 2, 0);
+    for (uint32_t k = 0; k < b1 - b0; ++k) ++levelCount_[levelOf_[k] + 1];
+    for (uint32_t L = 0; L <= top; ++L) levelCount_[L + 1] += levelCount_[L];
+    levelOrder_.resize(b1 - b0);
+    for (uint32_t k = 0; k < b1 - b0; ++k) levelOrder_[levelCount_[levelOf_[k]]++] = b0 + k;
+    // levelCount_[L] is now the end of level L in levelOrder_.
+    size_t pos = 0;
+    for (uint32_t L = 1; L <= top; ++L) {
+      const size_t end = levelCount_[L];
+      grouped = 0;
+      const size_t firstPacket = numPackets_;
+      const size_t firstSingle = items_.size();
+      for (; pos < end; ++pos) {
+        const uint32_t k = levelOrder_[pos];
+        if (!packable_[k - b0]) {
+          items_.push_back(int32_t(k));
+          continue;
+        }
+        group[grouped++] = k;
+        if (grouped == 4) {
+          // packets_ only grows (value-initialising 1 KB a packet every step cost 1-2 % of the trench bench).
+          if (numPackets_ == packets_.size()) packets_.resize(std::max<size_t>(64, 2 * packets_.size()));
+          Packet& p = packets_[numPackets_++];
+          for (int j = 0; j < 4; ++j) p.unit[j] = group[j];
+          grouped = 0;
+        }
+      }
+      for (int j = 0; j < grouped; ++j) items_.push_back(int32_t(group[j]));
+      // The level's packets go before its single units, in runs of up to kPacketRun solved by one kernel call.
+      const size_t numSingles = items_.size() - firstSingle;
+      for (size_t q = firstPacket; q < numPackets_; q += kPacketRun) {
+        const size_t c = std::min<size_t>(kPacketRun, numPackets_ - q);
+        items_.push_back(-1 - int32_t(q * 4 + (c - 1)));
+      }
+      std::rotate(items_.begin() + long(firstSingle), items_.begin() + long(firstSingle + numSingles), items_.end());
+    }
+  }
+  itemStart_[size_t(S)] = uint32_t(items_.size());
+  gPackedUnits += 4 * numPackets_;
+}
+
+void GranularStage::pack(const GranularBodySystem& ps) {
+  const auto& invM = ps.invMasses();
+  // The units are read in level order, scattered over units_: the next packet's are fetched ahead.
+  constexpr size_t kAhead = 2;
+  for (size_t q = 0; q < numPackets_; ++q) {
+    Packet& p = packets_[q];
+    if (q + kAhead < numPackets_)
+      for (int j = 0; j < 4; ++j) {
+        const char* c = reinterpret_cast<const char*>(&units_[packets_[q + kAhead].unit[j]]);
+        for (size_t off = 0; off < sizeof(Unit); off += 64) __builtin_prefetch(c + off);
+        __builtin_prefetch(c + sizeof(Unit) - 1);
+      }
+    for (int j = 0; j < 4; ++j) {
+      const Unit& u = units_[p.unit[j]];
+      const uint32_t a = u.a, b = uint32_t(u.b);
+      p.a[j] = a;
+      p.b[j] = b;
+      auto& f = p.f;
+      f[kNx][j] = u.n.x();
+      f[kNy][j] = u.n.y();
+      f[kNz][j] = u.n.z();
+      f[kT1x][j] = u.t1.x();
+      f[kT1y][j] = u.t1.y();
+      f[kT1z][j] = u.t1.z();
+      f[kT2x][j] = u.t2.x();
+      f[kT2y][j] = u.t2.y();
+      f[kT2z][j] = u.t2.z();
+      f[kSigma][j] = u.sigma;
+      f[kLa][j] = u.la;
+      f[kLb][j] = u.lb;
+      f[kKN][j] = u.kN;
+      f[kKT][j] = u.kT1;
+      f[kRhsN][j] = u.rhsN;
+      f[kEN][j] = u.eN;
+      f[kLoN][j] = u.loN;
+      f[kET][j] = u.eT;
+      f[kMu][j] = u.mu;
+      f[kRollMu][j] = u.rollMu;
+      f[kKR][j] = u.kR;
+      f[kImA][j] = invM[a];
+      f[kImB][j] = invM[b];
+      f[kInvIA][j] = invInertia_[a];
+      f[kInvIB][j] = invInertia_[b];
+      f[kLN][j] = u.lN;
+      f[kLT1][j] = u.lT1;
+      f[kLT2][j] = u.lT2;
+      f[kLR1][j] = u.lR1;
+      f[kLR2][j] = u.lR2;
+    }
+  }
+  packed_ = true;
+}
+
+void GranularStage::unpack() {
+  if (!packed_) return;
+  for (size_t q = 0; q < numPackets_; ++q)
+    for (int j = 0; j < 4; ++j) {
+      const Packet& p = packets_[q];
+      Unit& u = units_[p.unit[j]];
+      u.lN = p.f[kLN][j];
+      u.lT1 = p.f[kLT1][j];
+      u.lT2 = p.f[kLT2][j];
+      u.lR1 = p.f[kLR1][j];
+      u.lR2 = p.f[kLR2][j];
+    }
+  packed_ = false;
+}
+
 void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyState>& bodies, const Vec3& up,
                               int sweeps) {
+  unpack();  // the units' impulses, as the four-wide sweep left them
   if (units_.empty() || sweeps <= 0) return;
   const auto& x = ps.positions();
   const auto& r = ps.radii();
@@ -1010,6 +1486,7 @@ void GranularStage::storeResults(const GranularBodySystem& ps, const ParticleCon
   auto& pp = *contacts.particleParticle;
   auto& pg = *contacts.particleGeometry;
   const auto& sides = *contacts.geometrySides;
+  unpack();
   const Real invH = 1.0 / h;
   ppCache_.clear();
   pgCache_.clear();

@@ -30,6 +30,10 @@
 //                the point) are swept by solveCentred, the same law without the normal row's zero angular terms
 //                and with the tangents' angular parts as multiples of the basis (about half the arithmetic;
 //                docs/terrain.md, "Digging cost").
+//                Four-wide sweep (where the CPU has AVX2): each slab's units are swept in dependency-level order
+//                and centred units of one level, which share no particle, four at a time in SIMD lanes; the
+//                result is the scalar sweep's bit for bit (the .cpp's "Four-wide sweep" says why; memory, not
+//                arithmetic, bounds it, so the packets are prefetched).
 //   integrate    x += h v for live particles; a particle whose velocity or position turns non-finite is
 //                reported by id, keeps its last position and is stopped. Clusters joined by glued DIRECT bonds
 //                move by their exactly integrated rigid motion first (integrateBondedLumps, below).
@@ -160,6 +164,15 @@ class GranularStage {
   void storeResults(const GranularBodySystem& ps, const ParticleContactLists& contacts, Real h);
   size_t numUnits() const { return units_.size(); }
   int numSlabs() const { return numSlabs_; }
+  // ---- Vectorised centred sweep (issue 16, trench speed; see "Four-wide sweep" in the .cpp) ----------------
+  /// Whether this CPU runs the four-wide (AVX2) sweep of centred units; false: every unit is swept by the scalar
+  /// code in unit order. The results are bit-identical either way (the .cpp says why).
+  static bool vectorSweepAvailable();
+  /// Test and measurement switch (all stages of the process): false forces the scalar sweep. Default true.
+  static void setVectorSweepEnabled(bool on);
+  /// Units put into packets since the process started, over all stages (a test's evidence that the four-wide
+  /// path ran).
+  static uint64_t packedUnitsTotal();
 
  private:
   // One contact point between particle a and particle b or a geometry (its rigid body index `body`, -1 none).
@@ -274,6 +287,45 @@ class GranularStage {
   std::vector<char> lumpMoved_;  // [dense] moved by integrateBondedLumps this step (integrate skips it)
   static bool anyGluedMaterial(const std::vector<PairParams>& ppParams, size_t K);
   Real bondRestOf(uint64_t key, Real depth, bool& found) const;  // the remembered rest of the pair, else `depth`
+
+  // ---- Four-wide sweep of centred units (issue 16, trench speed; the .cpp's "Four-wide sweep") ---------------
+ public:
+  // Four centred units with 8 distinct particles, lane-interleaved (field f of lane j at f[f][j]): the unit data
+  // the sweep reads (a centred unit's two tangent gains are equal: one kKT; packed units have no surface
+  // velocity, so the friction targets are zero), the particles' inverse masses and inertias, and the impulses (the authoritative copy while
+  // packed_, written back to the units by unpack()).
+  enum PacketField : int {
+    kNx, kNy, kNz, kT1x, kT1y, kT1z, kT2x, kT2y, kT2z, kSigma, kLa, kLb, kKN, kKT, kRhsN, kEN, kLoN, kET, kMu,
+    kRollMu, kKR, kImA, kImB, kInvIA, kInvIB, kLN, kLT1, kLT2, kLR1, kLR2, kNumPacketFields
+  };
+  struct alignas(32) Packet {
+    uint32_t a[4], b[4];  // first: the kernel reads them first (then the particles' velocities)
+    uint32_t unit[4], pad[4];
+    double f[kNumPacketFields][4];
+  };
+
+ private:
+  std::vector<Packet> packets_;  // [0, numPackets_) in use
+  size_t numPackets_ = 0;
+  // Per slab, the sweep order as items: >= 0 a unit of units_ (scalar), < 0 the packet -1 - item.
+  std::vector<int32_t> items_;
+  std::vector<uint32_t> itemStart_;          // [numSlabs + 1] ranges into items_
+  std::vector<uint32_t> levelOf_, lastLevel_, stampOf_, levelCount_, levelOrder_;
+  std::vector<char> packable_;
+  uint32_t stamp_ = 0;
+  bool scheduleStale_ = true;  // buildRows made new units: the schedule and packets are rebuilt at the next sweep
+  bool packed_ = false;        // the packets hold the current impulses of their units
+  // What the schedule needs of each unit (in units_ order), written by buildRows.
+  struct SchedUnit {
+    uint32_t a = 0;
+    int32_t b = -1;
+    uint32_t packable = 0;
+  };
+  std::vector<SchedUnit> schedUnit_;
+  static bool packable(const Unit& u);  // may go into a packet (see the .cpp)
+  void buildSchedule(const GranularBodySystem& ps);
+  void pack(const GranularBodySystem& ps);  // unit data (and impulses) into packets_
+  void unpack();                            // packets' impulses back into units_
 };
 
 }  // namespace scree::detail
