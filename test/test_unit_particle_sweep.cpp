@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The four-wide particle sweep (solver/src/granular_stage.cpp, "Four-wide sweep"; docs/terrain.md, "Digging
 // cost", sixth round): centred particle units are solved four at a time in AVX2 lanes, each slab's units in
 // dependency-level order. The claim is that this is the scalar sweep bit for bit (units of one level share no
