@@ -94,7 +94,7 @@ inline constexpr Real kAnchorSlipTolerance = 1e-6;
 inline constexpr Real kAnchorSlipDistance = 0.01;
 /// An anchor resets when either body's anchor point lies farther than this times the manifold's mean point
 /// radius from the current centre (in the tangent plane).
-inline constexpr Real kAnchorReach = 0.25;
+inline constexpr Real kAnchorReach = 0.05;
 
 /// Row-build hook (contact_rows.cpp, manifold friction): adds the anchor's position term to the rows
 /// [t1, t1 + 1] (tangents mt1, mt2) and twist (about `normal`) of the manifold of `pair` centred at `centre`, and
