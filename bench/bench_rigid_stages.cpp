@@ -60,8 +60,8 @@ uint64_t fingerprint(const Simulation& sim) {
 }
 
 template <class S, class Build, class Drift>
-void runStages(benchmark::State& state, Build build, Drift drift) {
-  const int threads = int(state.range(0));
+void runStages(benchmark::State& state, Build build, Drift drift, int threadCount = 0) {
+  const int threads = threadCount > 0 ? threadCount : int(state.range(0));
   setNumThreads(threads);
   std::vector<double> wall;
   StepTimings sum;
@@ -108,6 +108,12 @@ void runStages(benchmark::State& state, Build build, Drift drift) {
   state.counters["fingerprint"] = double(fp & 0xffffffffu);
 }
 
+/// runStages on one thread, for benchmarks whose argument is not the thread count.
+template <class S, class Build, class Drift>
+void runStagesOneThread(benchmark::State& state, Build build, Drift drift) {
+  runStages<S>(state, build, drift, 1);
+}
+
 void BM_pyramid20_stages(benchmark::State& state) {
   runStages<PyramidScene>(state, [] { return buildPyramid20(); },
                           [](const PyramidScene& s) { return measurePyramid(s).maxDisplacement; });
@@ -133,6 +139,29 @@ void BM_tower10_stages(benchmark::State& state) {
                         [](const TowerScene& s) { return measureTower(s).topHorizontal; });
 }
 BENCHMARK(BM_tower10_stages)->Arg(1)->Arg(2)->Iterations(5)->Repetitions(3)->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// ---- issue 18 (friction anchors, Solver::setUseFrictionAnchors; docs/solver-internals.md "Friction anchors") ----
+// pyramid20 with anchors, with the shock pass (Arg 1) and without it (Arg 0), one thread; compare with
+// BM_pyramid20_stages/1 and BM_pyramid20_noshock_stages.
+PyramidScene buildPyramid20With(bool anchors, bool shock) {
+  PyramidScene s = buildPyramid20();
+  s.sim->getSolver().setUseFrictionAnchors(anchors);
+  s.sim->getSolver().setUseShockPropagation(shock);
+  return s;
+}
+void BM_pyramid20_anchor_stages(benchmark::State& state) {
+  const bool shock = state.range(0) != 0;
+  runStagesOneThread<PyramidScene>(state, [shock] { return buildPyramid20With(true, shock); },
+                                   [](const PyramidScene& s) { return measurePyramid(s).maxDisplacement; });
+}
+BENCHMARK(BM_pyramid20_anchor_stages)->Arg(1)->Arg(0)->Iterations(1)->Repetitions(3)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+void BM_pyramid20_noshock_stages(benchmark::State& state) {
+  runStagesOneThread<PyramidScene>(state, [] { return buildPyramid20With(false, false); },
+                                   [](const PyramidScene& s) { return measurePyramid(s).maxDisplacement; });
+}
+BENCHMARK(BM_pyramid20_noshock_stages)->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 }  // namespace

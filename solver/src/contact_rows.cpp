@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "contact_law.h"
+#include "friction_anchor.h"
 #include "rolling_radius.h"
 #include "step_stages.h"
 
@@ -22,6 +23,8 @@ void buildContactRows(SimulationState& s) {
   s.rows.clear();
   s.pointRows.clear();
   s.couplings.clear();
+  s.frictionAnchors.beginStep();  // issue 18 (friction anchors)
+  const bool anchors = solver.getUseFrictionAnchors();
   const ContactLawSettings law{h, solver.getRestitutionThreshold(), solver.getMaxPenetrationRecoverySpeed()};
   const bool warm = solver.getUseWarmStarting();
   size_t numPoints = 0, numWarm = 0, numSolvedContacts = 0;
@@ -305,6 +308,10 @@ void buildContactRows(SimulationState& s) {
       tw.lambda = warmTwist;
       tw.normalRow = firstNormal;
       tw.normalCount = int32_t(nActive);
+      // ---- issue 18 (friction anchors, friction_anchor.h): the position term of a sticking manifold ----
+      if (anchors && first->surfaceVelocity == zero)
+        anchorManifoldFriction(s, pair, ia, ib, centre, first->normal, mt1, mt2, rEff, base, base + 2,
+                               first->damping >= 0 ? first->damping : mat.getDamping());
     }
   }
   s.nonIterativeRows = nonIterative;

@@ -12,6 +12,7 @@
 
 #include "body_access.h"
 #include "contact_rows.h"
+#include "friction_anchor.h"  // issue 18 (friction anchors)
 #include "granular_stage.h"
 #include "scree/collide/particle_collider.h"
 #include "scree/collide/space.h"
@@ -99,6 +100,9 @@ struct SimulationState {
   // Issue 18 (solver sweep): the manifold normal blocks' operators, built by PgsSolver::prepare each step into
   // storage kept across steps (pgs.h PgsBlocks).
   PgsBlocks pgsBlocks;
+  // ---- issue 18 (friction anchors, friction_anchor.h): manifold anchors kept across steps and this step's
+  // anchored manifolds (Solver::setUseFrictionAnchors) ----
+  FrictionAnchorCache frictionAnchors;
 
   // ---- position projection: its own direct solver, so each keeps its cached symbolic analysis ---------------
   DirectSolver projector;

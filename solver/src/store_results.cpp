@@ -34,6 +34,7 @@ void storeResults(SimulationState& s) {
     s.warmStart.add({contactPairKey(c), p.featureId, warmLambda(pr.normal), fw, pr.impactSpeed, p.point});
   }
   s.warmStart.commit();
+  storeFrictionAnchors(s);  // issue 18 (friction anchors, friction_anchor.h): keep the anchors that stick
   for (const auto& r : s.ranges) r.c->storeResult(s.rows.data() + r.begin, s.rowDofs.data() + r.begin, r.count, s.h);
   if (s.granularStep) {
     const ParticleContactLists lists{&s.particleCollider.getParticleParticleContacts(),
