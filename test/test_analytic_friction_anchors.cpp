@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Friction anchors (Solver::setUseFrictionAnchors; solver/src/friction_anchor.h, docs/solver-internals.md
 // "Friction anchors"). What they must do: pull back the tangential creep that velocity-level friction lets
 // accumulate in a sticking contact (pyramid20 without the shock pass, a cube sticking on an incline), leave

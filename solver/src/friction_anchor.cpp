@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Friction anchors of contact manifolds (friction_anchor.h states the law and why).
 #include "friction_anchor.h"
 

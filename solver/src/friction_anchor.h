@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // Friction anchors of contact manifolds (issue 18, solver-private; Solver::setUseFrictionAnchors,
 // docs/solver-internals.md "Friction anchors").
 //
