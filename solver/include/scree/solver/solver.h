@@ -134,6 +134,17 @@ class Solver {
   /// default serial order (contacts in contact-list order), so trajectories differ from the default's.
   void setUseColouredSweeps(bool on) { colouredSweeps_ = on; }
   bool getUseColouredSweeps() const { return colouredSweeps_; }
+  // ---- issue 18 (sweep scheduling): partitioned sweeps ----
+  /// Partitioned PGS sweeps and a parallel shock pass (default off; PgsPartition, docs/solver-internals.md
+  /// "Partitioned sweeps"): the dynamic bodies are cut by a plane into two regions of about equal work; the
+  /// contacts and joints inside each region are swept by their own thread, those across the cut by one thread
+  /// between barriers (one barrier per sweep instead of one per colour). The shock pass runs the supports of
+  /// each region on their own thread in the same dependency order (its result equals the serial pass's).
+  /// Results are bit-identical for any thread count (setNumThreads). The sweep order differs from the default
+  /// serial order (each region's contacts, then those across the cut), so trajectories differ from the
+  /// default's. Takes precedence over setUseColouredSweeps when both are on.
+  void setUsePartitionedSweeps(bool on) { partitionedSweeps_ = on; }
+  bool getUsePartitionedSweeps() const { return partitionedSweeps_; }
   const SolverStats& getStats() const { return stats_; }
 
  private:
@@ -155,6 +166,7 @@ class Solver {
   Real constraintErrorThreshold_ = 0.1;
   SolverStats stats_;
   bool colouredSweeps_ = false;  // issue 18 (sweep scheduling)
+  bool partitionedSweeps_ = false;  // issue 18 (sweep scheduling): partitioned sweeps
 };
 
 }  // namespace scree
