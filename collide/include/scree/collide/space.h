@@ -62,7 +62,17 @@ class Space {
   std::vector<Aabb> boxes_;
   std::vector<Real> margins_;
   std::vector<std::pair<uint32_t, uint32_t>> pairs_;
-  std::vector<ContactPoint> scratchPoints_;
+  // ---- issue 18 (parallel narrowphase): the candidate pairs in fixed chunks, each chunk's contacts kept apart
+  // and merged in chunk order (space.cpp) ----
+  struct Hit {
+    Geometry *a, *b;
+    uint32_t begin, count;  // points in the chunk's buffer
+  };
+  struct Chunk {
+    std::vector<ContactPoint> points, scratch;
+    std::vector<Hit> hits;
+  };
+  std::vector<Chunk> chunks_;
 };
 
 }  // namespace scree

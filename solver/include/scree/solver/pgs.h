@@ -87,7 +87,8 @@ struct PgsColouring {
 /// boundary). Regions share no movable body, so they can be swept at the same time by different threads; the
 /// boundary is swept by one thread between barriers. The result does not depend on the thread count: on one
 /// thread the regions simply run one after the other. The schedule is data (an order of units and split points),
-/// independent of the row layout. Kept by the caller across steps (storage reused).
+/// independent of the row layout. Kept by the caller across steps (storage reused); the cut is kept while the
+/// units (their bodies and row counts, in order) stay the same as when it was made.
 struct PgsPartition {
   static constexpr int kRegions = 2;
   struct Unit {
@@ -105,6 +106,7 @@ struct PgsPartition {
   std::vector<uint32_t> sortedBodies, tmp;
   std::vector<Real> bodyWeight;
   std::vector<int8_t> unitGroup;
+  std::vector<uint64_t> signature;  ///< the units' body pairs and row counts when the cut was last made
   struct Remap {
     uint32_t row;
     int side;
@@ -180,6 +182,9 @@ class PgsSolver {
                         PgsPartition& partition);
 
  private:
+  /// The cutting plane and the bodies' regions (pgs_partition.cpp).
+  static void cutRegions(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                         PgsPartition& partition);
   /// One range of the shock pass swept to convergence (shockPass's per-range body).
   static void shockRange(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                          const ShockRange& sr, int maxSweeps, const PgsBlocks* blocks);
