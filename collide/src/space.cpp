@@ -134,7 +134,7 @@ void Space::collide(Real h, std::vector<GeometryContact>& out) {
   constexpr size_t kChunkPairs = 64;
   const size_t numChunks = (pairs_.size() + kChunkPairs - 1) / kChunkPairs;
   if (chunks_.size() < numChunks) chunks_.resize(numChunks);
-  const bool parallel = numChunks >= 4;
+  const bool parallel = parallelNarrowphase_ && numChunks >= 4;
 #pragma omp parallel for schedule(dynamic, 1) if (parallel)
   for (size_t c = 0; c < numChunks; ++c) {
     Chunk& ch = chunks_[c];

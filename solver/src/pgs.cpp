@@ -18,7 +18,9 @@
 //  - The visit multiplies by the block's precomputed inverse (PgsBlocks::Block::sInv) instead of two triangular
 //    solves: their six dependent divisions were the largest single cost of a visit.
 //  - Scheduling: the default sweep is serial in row order; Solver::setUseColouredSweeps selects graph-coloured
-//    sweeps shared among threads with bit-identical results (end of this file, pgs.h PgsColouring).
+//    sweeps shared among threads with bit-identical results (end of this file, pgs.h PgsColouring), and
+//    Solver::setUsePartitionedSweeps two regions and a boundary with one barrier per sweep plus a parallel shock
+//    pass equal to the serial one (end of this file, pgs_partition.cpp, pgs.h PgsPartition).
 //  - Not done: the base sweeps alone still do not hold pyramid20 (shock pass off: 49 cm at 10 iterations,
 //    over-relaxing the blocks made it worse).
 #include "scree/solver/pgs.h"
@@ -873,7 +875,6 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   bodies.resize(numBodies);
   return maxDelta;
 }
-
 
 // ---- issue 18 (sweep scheduling): partitioned sweeps (pgs.h PgsPartition; the cut in pgs_partition.cpp) ----
 // DESIGN (docs/solver-internals.md "Partitioned sweeps"): a forward sweep visits region 0's units, region 1's,

@@ -46,6 +46,14 @@ class Space {
   /// their point buffers are reused from the last call).
   void collide(Real h, std::vector<GeometryContact>& out);
 
+  // ---- issue 18 (parallel narrowphase) ----
+  /// Narrowphase of the candidate pairs shared among the threads (setNumThreads) in fixed chunks merged in order,
+  /// so the contacts are the same on any thread count (default off; the Simulation switches it on with
+  /// Solver::setUsePartitionedSweeps). Off by default because on a machine with more runnable threads than cores
+  /// the wait for the second thread cost more than the work (docs/solver-internals.md "Partitioned sweeps").
+  void setUseParallelNarrowphase(bool on) { parallelNarrowphase_ = on; }
+  bool getUseParallelNarrowphase() const { return parallelNarrowphase_; }
+
   /// Number of candidate pairs from the broadphase in the last collide().
   size_t getNumBroadphasePairs() const { return numPairs_; }
 
@@ -73,6 +81,7 @@ class Space {
     std::vector<Hit> hits;
   };
   std::vector<Chunk> chunks_;
+  bool parallelNarrowphase_ = false;
 };
 
 }  // namespace scree
