@@ -29,7 +29,6 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
-#include <thread>
 
 #include "contact_law.h"
 #include "scree/core/assert.h"
@@ -900,6 +899,48 @@ Real sweepUnits(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& 
   return m;
 }
 
+/// Synchronisation of the partitioned stages' two threads: spin briefly (the partner is usually a few
+/// microseconds away on idle cores), then sleep on the atomic (C++20 wait/notify, a futex on Linux). OpenMP's
+/// default barrier spins far longer; on the shared 2-core machine, with more runnable threads than cores, a
+/// spinning thread held the core its partner needed and 2-thread steps of pyramid20 took 4-130 ms against
+/// 0.9 ms on one thread (docs/solver-internals.md "Partitioned sweeps").
+constexpr int kSpinBeforeSleep = 2000;
+
+/// Waits until `a` holds at least `target`.
+inline void waitAtLeast(const std::atomic<uint32_t>& a, uint32_t target) {
+  uint32_t v = a.load(std::memory_order_acquire);
+  for (int spin = 0; v < target && spin < kSpinBeforeSleep; ++spin) v = a.load(std::memory_order_acquire);
+  while (v < target) {
+    a.wait(v, std::memory_order_acquire);
+    v = a.load(std::memory_order_acquire);
+  }
+}
+
+/// A reusable barrier for a team of n threads (phase counting).
+class TeamBarrier {
+ public:
+  explicit TeamBarrier(int n) : n_(uint32_t(n)) {}
+  void wait() {
+    const uint32_t phase = phase_.load(std::memory_order_acquire);
+    if (arrived_.fetch_add(1, std::memory_order_acq_rel) + 1 == n_) {
+      arrived_.store(0, std::memory_order_relaxed);
+      phase_.store(phase + 1, std::memory_order_release);
+      phase_.notify_all();
+      return;
+    }
+    uint32_t v = phase_.load(std::memory_order_acquire);
+    for (int spin = 0; v == phase && spin < kSpinBeforeSleep; ++spin) v = phase_.load(std::memory_order_acquire);
+    while (v == phase) {
+      phase_.wait(v, std::memory_order_acquire);
+      v = phase_.load(std::memory_order_acquire);
+    }
+  }
+
+ private:
+  const uint32_t n_;
+  std::atomic<uint32_t> arrived_{0}, phase_{0};
+};
+
 /// Threads for a partitioned stage: at most one per region; 1 without OpenMP or for small work (the result is
 /// the same either way).
 int partitionThreads(bool worthIt) {
@@ -954,6 +995,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   const bool boundary = split[R + 1] > split[R];
   const int threads = partitionThreads(p.order.size() >= 64);
   Real lastSweep[R] = {};
+  TeamBarrier barrier(threads);
 #pragma omp parallel num_threads(threads) if (threads > 1)
   {
     const int t = threadIndex(), nt = teamSize();
@@ -970,9 +1012,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
       local = 0;
       if (forward) regions(true);
       else boundaryUnits(false);
-      if (boundary && nt > 1) {
-#pragma omp barrier
-      }
+      if (boundary && nt > 1) barrier.wait();
       if (forward) boundaryUnits(true);
       else regions(false);
     }
@@ -1035,10 +1075,10 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
       const std::vector<uint32_t>& list = p.shockList[t];
       const std::vector<uint32_t>& wait = p.shockWait[t];
       for (size_t j = 0; j < list.size(); ++j) {
-        for (int spin = 0; done[other].load(std::memory_order_acquire) < wait[j]; ++spin)
-          if (spin > 256) std::this_thread::yield();
+        waitAtLeast(done[other], wait[j]);
         shockRange(rows, bodies, ranges[list[j]], maxSweeps, blocks);
         done[t].store(uint32_t(j + 1), std::memory_order_release);
+        done[t].notify_all();
       }
     }
   }
