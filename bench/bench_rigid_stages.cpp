@@ -134,6 +134,20 @@ void BM_pyramid20_coloured_stages(benchmark::State& state) {
 BENCHMARK(BM_pyramid20_coloured_stages)->Arg(1)->Arg(2)->Iterations(1)->Repetitions(3)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// Issue 18 (sweep scheduling): partitioned sweeps and the parallel shock pass (Solver::setUsePartitionedSweeps);
+// the 1- and 2-thread fingerprints agree.
+void BM_pyramid20_partitioned_stages(benchmark::State& state) {
+  runStages<PyramidScene>(state,
+                          [] {
+                            PyramidScene s = buildPyramid20();
+                            s.sim->getSolver().setUsePartitionedSweeps(true);
+                            return s;
+                          },
+                          [](const PyramidScene& s) { return measurePyramid(s).maxDisplacement; });
+}
+BENCHMARK(BM_pyramid20_partitioned_stages)->Arg(1)->Arg(2)->Iterations(1)->Repetitions(3)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_tower10_stages(benchmark::State& state) {
   runStages<TowerScene>(state, [] { return buildTower10(); },
                         [](const TowerScene& s) { return measureTower(s).topHorizontal; });

@@ -91,4 +91,104 @@ TEST_CASE("coloured sweeps: pyramid20 is bit-identical on 1 and 2 threads and st
   CHECK(m1.maxDisplacement < 0.01);
 }
 
+// ---- issue 18 (sweep scheduling): partitioned sweeps (Solver::setUsePartitionedSweeps, PgsPartition) ----
+TEST_CASE("partition: regions share no dynamic body, the boundary touches both, the work is halved") {
+  // Bodies 0-7 dynamic in a row along x (y scrambled, so that a cut along y would cross many contacts), body 8
+  // static. Units: each box on the static ground (2 rows), and a contact between neighbours (3 rows).
+  const int n = 8;
+  std::vector<SolverBodyState> bodies(n + 1);
+  PgsPartition p;
+  p.bodyPosition.resize(n + 1, Vec3::Zero());
+  const Real ys[n] = {0.3, -0.2, 0.5, 0.1, -0.4, 0.2, -0.1, 0.4};
+  for (int i = 0; i < n; ++i) {
+    bodies[size_t(i)].invMass = 1;
+    bodies[size_t(i)].invInertia = Mat3::Identity();
+    p.bodyPosition[size_t(i)] = Vec3(Real(i), ys[i], 0);
+  }
+  std::vector<ConstraintRow> rows;
+  auto addUnit = [&](int a, int b, int count) {
+    p.units.push_back({uint32_t(rows.size()), uint32_t(count)});
+    for (int k = 0; k < count; ++k) {
+      ConstraintRow r;
+      r.bodyA = a;
+      r.bodyB = b;
+      rows.push_back(r);
+    }
+  };
+  for (int i = 0; i < n; ++i) addUnit(n, i, 2);
+  for (int i = 0; i + 1 < n; ++i) addUnit(i, i + 1, 3);
+  PgsSolver::partition(rows, bodies, p);
+  CHECK(p.axis == 0);  // x: one contact crosses the cut (y: several)
+  constexpr int R = PgsPartition::kRegions;
+  REQUIRE(p.split[R + 1] == p.units.size());
+  REQUIRE(p.order.size() == p.units.size());
+  // Every body's weight is 2 + 3 (or 2 + 1.5 at the ends): the weighted median cuts between bodies 3 and 4.
+  for (int i = 0; i < n; ++i) CHECK(p.bodyRegion[size_t(i)] == (i < 4 ? 0 : 1));
+  CHECK(p.bodyRegion[size_t(n)] == -1);  // static: no region
+  // Region 0: ground units of 0-3 and contacts 0-1, 1-2, 2-3 (7 units); region 1 likewise; the boundary 3-4.
+  CHECK(p.split[1] - p.split[0] == 7);
+  CHECK(p.split[2] - p.split[1] == 7);
+  CHECK(p.split[3] - p.split[2] == 1);
+  std::set<uint32_t> seen;
+  for (int g = 0; g <= R; ++g)
+    for (uint32_t u = p.split[g]; u < p.split[g + 1]; ++u) {
+      const auto& un = p.order[u];
+      seen.insert(un.begin);
+      std::set<int> regions;
+      for (int b : {rows[un.begin].bodyA, rows[un.begin].bodyB})
+        if (b != n) regions.insert(p.bodyRegion[size_t(b)]);
+      if (g < R) CHECK((regions.size() == 1 && *regions.begin() == g));
+      else CHECK(regions.size() == 2);
+      if (u > p.split[g]) CHECK(p.order[u - 1].begin < un.begin);  // the serial order kept within a group
+    }
+  CHECK(seen.size() == p.units.size());
+}
+
+namespace {
+/// pyramid20's state (positions, velocities, angular velocities, the top's rotation) after `steps` steps (0: the
+/// scene's 600) with partitioned sweeps on `threads` threads.
+std::pair<std::vector<Real>, scenes::PyramidMetrics> runPartitioned(int threads, bool shock, int steps) {
+  setNumThreads(threads);
+  scenes::PyramidScene s = scenes::buildPyramid20();
+  s.sim->getSolver().setUsePartitionedSweeps(true);
+  s.sim->getSolver().setUseShockPropagation(shock);
+  for (int i = 0; i < (steps > 0 ? steps : s.numSteps); ++i) s.step();
+  setNumThreads(1);
+  std::vector<Real> state;
+  for (const RigidBodyRef& b : s.sim->getRigidBodies())
+    for (const Vec3& v : {b->getPosition(), b->getVelocity(), b->getAngularVelocity()})
+      state.insert(state.end(), v.data(), v.data() + 3);
+  const Quat q = s.top->getRotation();
+  state.insert(state.end(), {q.w(), q.x(), q.y(), q.z()});
+  return {state, scenes::measurePyramid(s)};
+}
+}  // namespace
+
+TEST_CASE("partitioned sweeps: pyramid20 is bit-identical on 1 and 2 threads, with and without the shock pass") {
+  setNumThreads(2);
+  const bool twoThreads = getNumThreads() == 2;  // 1 when built without OpenMP: the check below is then trivial
+  setNumThreads(1);
+  WARN_MESSAGE(twoThreads, "built without OpenMP: the 2-thread run used one thread");
+  for (const bool shock : {true, false}) {
+    CAPTURE(shock);
+    // Without the shock pass 150 steps (2.5 s) suffice to compare bits (the 2-thread runs are slow on a loaded
+    // machine; docs/solver-internals.md "Partitioned sweeps").
+    const int steps = shock ? 0 : 150;
+    const auto [one, m1] = runPartitioned(1, shock, steps);
+    const auto [two, m2] = runPartitioned(2, shock, steps);
+    REQUIRE(one.size() == two.size());
+    // Bit for bit: the two regions touch disjoint dynamic bodies (sweeps), and each shock range waits for the
+    // writers of its frozen body (shock pass), so the thread count cannot change the result.
+    CHECK(std::memcmp(one.data(), two.data(), one.size() * sizeof(Real)) == 0);
+    CHECK(m1.finite);
+    // With the shock pass: the issue's accuracy goal for pyramid20 at 10 iterations (drift under 1 cm) holds in
+    // the partitioned order too (measured 0.0081 cm; serial 0.0049 cm). Without it the pyramid leans whatever
+    // the order (docs/solver-internals.md "pyramid20 without the shock pass"); only the bits are compared.
+    if (shock) {
+      CHECK(m1.stands);
+      CHECK(m1.maxDisplacement < 0.01);
+    }
+  }
+}
+
 }  // TEST_SUITE

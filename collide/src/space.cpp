@@ -125,19 +125,44 @@ void Space::collide(Real h, std::vector<GeometryContact>& out) {
   numPairs_ = pairs_.size();
 
   // --- filter and narrowphase -----------------------------------------------------------------------------
-  for (const auto& [i, j] : pairs_) {
-    Geometry* ga = geoms_[i].get();
-    Geometry* gb = geoms_[j].get();
-    if (!canCollide(*ga, *gb)) continue;
-    Real pairMargin = margins_[i] + margins_[j];
-    if (ga->getId() > gb->getId()) std::swap(ga, gb);
-    scratchPoints_.clear();
-    if (collideGeometries(*ga, *gb, pairMargin, scratchPoints_) <= 0 || scratchPoints_.empty()) continue;
-    if (used == out.size()) out.emplace_back();
-    GeometryContact& c = out[used++];
-    c.reset(ga, gb, ga->getRigidBody(), gb->getRigidBody());
-    c.points().assign(scratchPoints_.begin(), scratchPoints_.end());
-    c.setSensor(ga->isSensor() || gb->isSensor());
+  // DESIGN (issue 18, parallel narrowphase; docs/solver-internals.md "Partitioned sweeps"): the candidate pairs
+  // are cut into chunks of a fixed size (independent of the thread count); the threads share the chunks, each
+  // chunk collects its touching pairs and their points in its own buffers (kept across steps: no allocation in
+  // a steady scene), and the chunks are merged in order. Each pair's narrowphase reads only its two geometries
+  // (transforms updated above), so the contacts -- and, after the sort below, their order -- are the same for
+  // any thread count. Few pairs are not worth waking threads for; the result is the same either way.
+  constexpr size_t kChunkPairs = 64;
+  const size_t numChunks = (pairs_.size() + kChunkPairs - 1) / kChunkPairs;
+  if (chunks_.size() < numChunks) chunks_.resize(numChunks);
+  const bool parallel = parallelNarrowphase_ && numChunks >= 4;
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
+  for (size_t c = 0; c < numChunks; ++c) {
+    Chunk& ch = chunks_[c];
+    ch.points.clear();
+    ch.hits.clear();
+    const size_t end = std::min(pairs_.size(), (c + 1) * kChunkPairs);
+    for (size_t k = c * kChunkPairs; k < end; ++k) {
+      const auto [i, j] = pairs_[k];
+      Geometry* ga = geoms_[i].get();
+      Geometry* gb = geoms_[j].get();
+      if (!canCollide(*ga, *gb)) continue;
+      const Real pairMargin = margins_[i] + margins_[j];
+      if (ga->getId() > gb->getId()) std::swap(ga, gb);
+      ch.scratch.clear();
+      if (collideGeometries(*ga, *gb, pairMargin, ch.scratch) <= 0 || ch.scratch.empty()) continue;
+      ch.hits.push_back({ga, gb, uint32_t(ch.points.size()), uint32_t(ch.scratch.size())});
+      ch.points.insert(ch.points.end(), ch.scratch.begin(), ch.scratch.end());
+    }
+  }
+  for (size_t c = 0; c < numChunks; ++c) {
+    const Chunk& ch = chunks_[c];
+    for (const Hit& hit : ch.hits) {
+      if (used == out.size()) out.emplace_back();
+      GeometryContact& gc = out[used++];
+      gc.reset(hit.a, hit.b, hit.a->getRigidBody(), hit.b->getRigidBody());
+      gc.points().assign(ch.points.begin() + hit.begin, ch.points.begin() + hit.begin + hit.count);
+      gc.setSensor(hit.a->isSensor() || hit.b->isSensor());
+    }
   }
 
   out.resize(used);

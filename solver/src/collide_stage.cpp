@@ -35,6 +35,9 @@ void syncGeometries(SimulationState& s) {
 }
 
 void collideGeometries(SimulationState& s) {
+  // Issue 18 (sweep scheduling): the partitioned-sweeps option also shares the narrowphase among the threads
+  // (Space::setUseParallelNarrowphase; the contacts are the same on any thread count).
+  s.space.setUseParallelNarrowphase(s.solver.getUsePartitionedSweeps());
   s.space.collide(s.h, s.contacts);
   s.stats.numBroadphasePairs = s.space.getNumBroadphasePairs();
 }

@@ -18,18 +18,25 @@
 //  - The visit multiplies by the block's precomputed inverse (PgsBlocks::Block::sInv) instead of two triangular
 //    solves: their six dependent divisions were the largest single cost of a visit.
 //  - Scheduling: the default sweep is serial in row order; Solver::setUseColouredSweeps selects graph-coloured
-//    sweeps shared among threads with bit-identical results (end of this file, pgs.h PgsColouring).
+//    sweeps shared among threads with bit-identical results (end of this file, pgs.h PgsColouring), and
+//    Solver::setUsePartitionedSweeps two regions and a boundary with one barrier per sweep plus a parallel shock
+//    pass equal to the serial one (end of this file, pgs_partition.cpp, pgs.h PgsPartition).
 //  - Not done: the base sweeps alone still do not hold pyramid20 (shock pass off: 49 cm at 10 iterations,
 //    over-relaxing the blocks made it worse).
 #include "scree/solver/pgs.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cstddef>
 #include <cmath>
 
 #include "contact_law.h"
 #include "scree/core/assert.h"
+
+#ifdef SCREE_WITH_OPENMP
+#include <omp.h>
+#endif
 
 namespace scree::detail {
 
@@ -1064,8 +1071,10 @@ const PgsBlocks::Manifold* compactAt(const PgsBlocks& pb, uint32_t row) {
 }
 }  // namespace
 
-void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
-                          const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks) {
+// One range swept to convergence (issue 18, sweep scheduling: a function of its own so that the partitioned shock
+// pass at the end of this file runs the same law).
+void PgsSolver::shockRange(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                           const ShockRange& sr, int maxSweeps, const PgsBlocks* blocks) {
   auto solveFrozen = [&](ConstraintRow& r, int frozen, Real lo, Real hi) -> Real {
     // Diagonal with only the free body's mass.
     Real k = r.e;
@@ -1138,22 +1147,25 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
       }
     }
   };
-  for (const ShockRange& sr : ranges) {
-    if (blocks) {
-      // DESIGN (issue 18, compact contact arrays): a manifold support reads the compact record the sweeps used.
-      if (const PgsBlocks::Manifold* m = compactAt(*blocks, sr.begin)) {
-        if (solveSupportCompact(rows, bodies, sr, *blocks, *m)) continue;
-      } else if (solveSupportExactly(rows, bodies, sr, *blocks)) {
-        continue;
-      }
-    }
-    for (int sweep = 0; sweep < maxSweeps; ++sweep) {
-      Real change = 0, scale = 0;
-      sweepRange(sr, change, scale);
-      // Converged: the support's impulses moved by less than kShockTolerance of their size.
-      if (change <= kShockTolerance * scale) break;
+  if (blocks) {
+    // DESIGN (issue 18, compact contact arrays): a manifold support reads the compact record the sweeps used.
+    if (const PgsBlocks::Manifold* m = compactAt(*blocks, sr.begin)) {
+      if (solveSupportCompact(rows, bodies, sr, *blocks, *m)) return;
+    } else if (solveSupportExactly(rows, bodies, sr, *blocks)) {
+      return;
     }
   }
+  for (int sweep = 0; sweep < maxSweeps; ++sweep) {
+    Real change = 0, scale = 0;
+    sweepRange(sr, change, scale);
+    // Converged: the support's impulses moved by less than kShockTolerance of their size.
+    if (change <= kShockTolerance * scale) break;
+  }
+}
+
+void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                          const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks) {
+  for (const ShockRange& sr : ranges) shockRange(rows, bodies, sr, maxSweeps, blocks);
 }
 
 // ---- issue 18 (sweep scheduling): graph-coloured sweeps (pgs.h PgsColouring) ----
@@ -1262,6 +1274,215 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   for (const PgsColouring::Remap& r : c.remapped) (r.side == 0 ? rows[r.row].bodyA : rows[r.row].bodyB) = r.body;
   bodies.resize(numBodies);
   return maxDelta;
+}
+
+// ---- issue 18 (sweep scheduling): partitioned sweeps (pgs.h PgsPartition; the cut in pgs_partition.cpp) ----
+// DESIGN (docs/solver-internals.md "Partitioned sweeps"): a forward sweep visits region 0's units, region 1's,
+// then the boundary's; a backward sweep the boundary's, then the regions', all reversed. The regions share no
+// movable body, so region 0 and region 1 commute exactly and run on two threads at once; on one thread they run
+// one after the other with the same bits. The boundary runs on thread 0 between barriers. Since the sweeps
+// alternate direction, a forward sweep's boundary is followed by the next backward sweep's boundary and a
+// backward sweep's regions by the next forward sweep's regions, each on the same thread, so every sweep needs
+// one barrier (none when the boundary is empty). Static and kinematic bodies: region 1's units read private
+// copies (as in the coloured sweeps above), so that no two threads store to one body even when adding zero.
+namespace {
+Real sweepUnits(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                const PgsPartition::Unit* order, uint32_t first, uint32_t last, bool forward,
+                const PgsBlocks* blocks) {
+  Real m = 0;
+  if (forward) {
+    for (uint32_t u = first; u < last; ++u)
+      m = std::max(m, sweepRows(rows, bodies, order[u].begin, order[u].begin + order[u].count, true, blocks));
+  } else {
+    for (uint32_t u = last; u-- > first;)
+      m = std::max(m, sweepRows(rows, bodies, order[u].begin, order[u].begin + order[u].count, false, blocks));
+  }
+  return m;
+}
+
+/// Synchronisation of the partitioned stages' two threads: spin briefly (the partner is usually a few
+/// microseconds away on idle cores), then sleep on the atomic (C++20 wait/notify, a futex on Linux). OpenMP's
+/// default barrier spins far longer; on the shared 2-core machine, with more runnable threads than cores, a
+/// spinning thread held the core its partner needed and 2-thread steps of pyramid20 took 4-130 ms against
+/// 0.9 ms on one thread (docs/solver-internals.md "Partitioned sweeps").
+constexpr int kSpinBeforeSleep = 2000;
+
+/// Waits until `a` holds at least `target`.
+inline void waitAtLeast(const std::atomic<uint32_t>& a, uint32_t target) {
+  uint32_t v = a.load(std::memory_order_acquire);
+  for (int spin = 0; v < target && spin < kSpinBeforeSleep; ++spin) v = a.load(std::memory_order_acquire);
+  while (v < target) {
+    a.wait(v, std::memory_order_acquire);
+    v = a.load(std::memory_order_acquire);
+  }
+}
+
+/// A reusable barrier for a team of n threads (phase counting).
+class TeamBarrier {
+ public:
+  explicit TeamBarrier(int n) : n_(uint32_t(n)) {}
+  void wait() {
+    const uint32_t phase = phase_.load(std::memory_order_acquire);
+    if (arrived_.fetch_add(1, std::memory_order_acq_rel) + 1 == n_) {
+      arrived_.store(0, std::memory_order_relaxed);
+      phase_.store(phase + 1, std::memory_order_release);
+      phase_.notify_all();
+      return;
+    }
+    uint32_t v = phase_.load(std::memory_order_acquire);
+    for (int spin = 0; v == phase && spin < kSpinBeforeSleep; ++spin) v = phase_.load(std::memory_order_acquire);
+    while (v == phase) {
+      phase_.wait(v, std::memory_order_acquire);
+      v = phase_.load(std::memory_order_acquire);
+    }
+  }
+
+ private:
+  const uint32_t n_;
+  std::atomic<uint32_t> arrived_{0}, phase_{0};
+};
+
+/// Threads for a partitioned stage: at most one per region; 1 without OpenMP or for small work (the result is
+/// the same either way).
+int partitionThreads(bool worthIt) {
+#ifdef SCREE_WITH_OPENMP
+  return worthIt ? std::min(PgsPartition::kRegions, omp_get_max_threads()) : 1;
+#else
+  (void)worthIt;
+  return 1;
+#endif
+}
+
+inline int threadIndex() {
+#ifdef SCREE_WITH_OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+inline int teamSize() {
+#ifdef SCREE_WITH_OPENMP
+  return omp_get_num_threads();
+#else
+  return 1;
+#endif
+}
+}  // namespace
+
+Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
+                        const PgsBlocks* blocks, PgsPartition& p) {
+  constexpr int R = PgsPartition::kRegions;
+  // Private copies of static and kinematic bodies for the units of regions 1 .. R-1 (one per body and region).
+  const size_t numBodies = bodies.size();
+  p.remapped.clear();
+  for (int g = 1; g < R; ++g) {
+    p.tmp.assign(numBodies, 0);  // 1 + index of the copy
+    for (uint32_t u = p.split[g]; u < p.split[g + 1]; ++u)
+      for (uint32_t i = p.order[u].begin; i < p.order[u].begin + p.order[u].count; ++i)
+        for (int side = 0; side < 2; ++side) {
+          int32_t& b = side == 0 ? rows[i].bodyA : rows[i].bodyB;
+          if (b < 0 || size_t(b) >= numBodies || movable(bodies[size_t(b)])) continue;
+          if (p.tmp[size_t(b)] == 0) {
+            p.tmp[size_t(b)] = uint32_t(bodies.size()) + 1;
+            const SolverBodyState body = bodies[size_t(b)];
+            bodies.push_back(body);
+          }
+          p.remapped.push_back({i, side, b});
+          b = int32_t(p.tmp[size_t(b)] - 1);
+        }
+  }
+  const PgsPartition::Unit* order = p.order.data();
+  const uint32_t* split = p.split;
+  const bool boundary = split[R + 1] > split[R];
+  const int threads = partitionThreads(p.order.size() >= 64);
+  Real lastSweep[R] = {};
+  TeamBarrier barrier(threads);
+#pragma omp parallel num_threads(threads) if (threads > 1)
+  {
+    const int t = threadIndex(), nt = teamSize();
+    Real local = 0;
+    auto regions = [&](bool forward) {
+      for (int g = 0; g < R; ++g)
+        if (g % nt == t) local = std::max(local, sweepUnits(rows, bodies, order, split[g], split[g + 1], forward, blocks));
+    };
+    auto boundaryUnits = [&](bool forward) {
+      if (t == 0) local = std::max(local, sweepUnits(rows, bodies, order, split[R], split[R + 1], forward, blocks));
+    };
+    for (int it = 0; it < iterations; ++it) {
+      const bool forward = it % 2 == 0;
+      local = 0;
+      if (forward) regions(true);
+      else boundaryUnits(false);
+      if (boundary && nt > 1) barrier.wait();
+      if (forward) boundaryUnits(true);
+      else regions(false);
+    }
+    if (t < R) lastSweep[t] = local;
+  }
+  Real maxDelta = 0;
+  for (int t = 0; t < R; ++t) maxDelta = std::max(maxDelta, lastSweep[t]);
+  // Back to the shared static bodies.
+  for (const PgsPartition::Remap& r : p.remapped) (r.side == 0 ? rows[r.row].bodyA : rows[r.row].bodyB) = r.body;
+  bodies.resize(numBodies);
+  return maxDelta;
+}
+
+// DESIGN (docs/solver-internals.md "Partitioned sweeps"): a shock range writes only its free body and reads its
+// frozen one, whose writers (the ranges where it is free) all come earlier in the support order. So each range
+// runs after the earlier ranges of its free body -- kept by giving every range of one free body to the same
+// thread, in order -- and after the last range whose free body is its frozen one. Ranges go to the thread of
+// their free body's region; a range whose frozen body belongs to the other thread waits (spinning on that
+// thread's count of finished ranges) for that writer. Every range then sees exactly the velocities the serial
+// pass shows it: the result is the serial shockPass's, bit for bit, on any number of threads.
+void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                          const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks,
+                          PgsPartition& p) {
+  constexpr int R = PgsPartition::kRegions;
+  const int threads = partitionThreads(ranges.size() >= 16);
+  if (threads < 2) {
+    shockPass(rows, bodies, ranges, maxSweeps, blocks);
+    return;
+  }
+  const size_t nb = bodies.size();
+  auto listOf = [&](int32_t b) {
+    return b >= 0 && size_t(b) < p.bodyRegion.size() && p.bodyRegion[size_t(b)] > 0 ? int(p.bodyRegion[size_t(b)]) : 0;
+  };
+  for (int r = 0; r < R; ++r) {
+    p.shockList[r].clear();
+    p.shockWait[r].clear();
+  }
+  p.shockDone.assign(nb, 0);
+  for (uint32_t k = 0; k < ranges.size(); ++k) {
+    const ShockRange& sr = ranges[k];
+    const ConstraintRow& r0 = rows[sr.begin];
+    const int32_t freeB = sr.frozen == 0 ? r0.bodyB : r0.bodyA, frozenB = sr.frozen == 0 ? r0.bodyA : r0.bodyB;
+    const int l = listOf(freeB);
+    uint32_t wait = 0;
+    if (frozenB >= 0 && size_t(frozenB) < nb && listOf(frozenB) != l) wait = p.shockDone[size_t(frozenB)];
+    p.shockList[l].push_back(k);
+    p.shockWait[l].push_back(wait);
+    if (freeB >= 0 && size_t(freeB) < nb) p.shockDone[size_t(freeB)] = uint32_t(p.shockList[l].size());
+  }
+  std::atomic<uint32_t> done[R];
+  for (auto& d : done) d.store(0, std::memory_order_relaxed);
+#pragma omp parallel num_threads(threads)
+  {
+    const int t = threadIndex(), nt = teamSize();
+    if (nt < R) {
+      // Fewer threads than lists: the serial pass (the same bits).
+      if (t == 0) shockPass(rows, bodies, ranges, maxSweeps, blocks);
+    } else if (t < R) {
+      const int other = 1 - t;
+      const std::vector<uint32_t>& list = p.shockList[t];
+      const std::vector<uint32_t>& wait = p.shockWait[t];
+      for (size_t j = 0; j < list.size(); ++j) {
+        waitAtLeast(done[other], wait[j]);
+        shockRange(rows, bodies, ranges[list[j]], maxSweeps, blocks);
+        done[t].store(uint32_t(j + 1), std::memory_order_release);
+        done[t].notify_all();
+      }
+    }
+  }
 }
 
 }  // namespace scree::detail

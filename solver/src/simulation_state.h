@@ -92,6 +92,9 @@ struct SimulationState {
   std::vector<uint32_t> levelStart;
   std::vector<std::pair<int, uint32_t>> orderSorted;
   PgsColouring colouring;  // coloured sweeps (Solver::setUseColouredSweeps), storage reused across steps
+  // ---- issue 18 (sweep scheduling): partitioned sweeps (Solver::setUsePartitionedSweeps), storage reused ----
+  PgsPartition partition;
+  bool partitionReady = false;  // the partition was computed for this step's rows (iterative paths only)
   // Warm-start source (issue 18, solve_stage.cpp rigidShock): per contact row in the rigid shock pass, the
   // sweeps' impulse (plus, for a single support's normal rows, an even share of the load the pass added); NaN for
   // other rows; empty when no shock pass ran. storeResults caches these instead of the solved impulses.

@@ -116,7 +116,10 @@ void rigidShock(SimulationState& s, bool onlyIterative) {
     if (r.begin >= contactEnd) continue;
     for (uint32_t i = r.begin; i < r.begin + r.count; ++i) s.sweepLambda[i] = s.rows[i].lambda;
   }
-  PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations(), &s.pgsBlocks);
+  if (s.partitionReady)  // issue 18 (sweep scheduling): the same pass, each region's supports on its own thread
+    PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations(), &s.pgsBlocks, s.partition);
+  else
+    PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations(), &s.pgsBlocks);
   for (const PgsSolver::ShockRange& r : sh) {
     if (r.begin >= contactEnd || (freeBody(r) >= 0 && s.shockSupports[freeBody(r)] > 1)) continue;
     Real added = 0;
@@ -239,13 +242,24 @@ void hybridPath(SimulationState& s, bool finalDirect, bool particleDirect) {
 /// The rigid PGS sweeps: serial in row order, or coloured (Solver::setUseColouredSweeps; units = couplings, which
 /// cover every row on these paths).
 Real rigidSweeps(SimulationState& s, int iterations) {
+  if (s.partitionReady) return PgsSolver::iterate(s.rows, s.sb, iterations, &s.pgsBlocks, s.partition);
   if (!s.solver.getUseColouredSweeps()) return PgsSolver::iterate(s.rows, s.sb, iterations, &s.pgsBlocks);
   return PgsSolver::iterate(s.rows, s.sb, iterations, &s.pgsBlocks, s.colouring);
 }
 
 /// INTERLEAVED and ITERATIVE: PGS sweeps over all rows and particle units, then the shock passes.
 void iterativePath(SimulationState& s, bool interleaved) {
-  if (s.solver.getUseColouredSweeps() && !s.rows.empty()) {
+  // Issue 18 (sweep scheduling): partitioned sweeps take precedence over coloured ones.
+  if (s.solver.getUsePartitionedSweeps() && !s.rows.empty()) {
+    PgsPartition& p = s.partition;
+    p.units.clear();
+    for (const CouplingRange& c : s.couplings) p.units.push_back({c.begin, c.count});
+    p.bodyPosition.resize(s.sb.size());
+    for (size_t i = 0; i < s.sb.size(); ++i)
+      p.bodyPosition[i] = i < s.bodies.size() ? s.bodies[i]->getPosition() : Vec3::Zero();
+    PgsSolver::partition(s.rows, s.sb, p);
+    s.partitionReady = true;
+  } else if (s.solver.getUseColouredSweeps() && !s.rows.empty()) {
     s.colouring.units.clear();
     for (const CouplingRange& c : s.couplings) s.colouring.units.push_back({c.begin, c.count});
     PgsSolver::colour(s.rows, s.sb, s.colouring);
@@ -283,6 +297,7 @@ void solve(SimulationState& s) {
   s.directSet.clear();
   s.iterSet.clear();
   s.sweepLambda.clear();
+  s.partitionReady = false;
   if (choosePath(s) == SolvePath::NOTHING) {
     st.numIterations = 0;
     st.lastResidual = 0;

@@ -46,6 +46,14 @@ class Space {
   /// their point buffers are reused from the last call).
   void collide(Real h, std::vector<GeometryContact>& out);
 
+  // ---- issue 18 (parallel narrowphase) ----
+  /// Narrowphase of the candidate pairs shared among the threads (setNumThreads) in fixed chunks merged in order,
+  /// so the contacts are the same on any thread count (default off; the Simulation switches it on with
+  /// Solver::setUsePartitionedSweeps). Off by default because on a machine with more runnable threads than cores
+  /// the wait for the second thread cost more than the work (docs/solver-internals.md "Partitioned sweeps").
+  void setUseParallelNarrowphase(bool on) { parallelNarrowphase_ = on; }
+  bool getUseParallelNarrowphase() const { return parallelNarrowphase_; }
+
   /// Number of candidate pairs from the broadphase in the last collide().
   size_t getNumBroadphasePairs() const { return numPairs_; }
 
@@ -62,7 +70,18 @@ class Space {
   std::vector<Aabb> boxes_;
   std::vector<Real> margins_;
   std::vector<std::pair<uint32_t, uint32_t>> pairs_;
-  std::vector<ContactPoint> scratchPoints_;
+  // ---- issue 18 (parallel narrowphase): the candidate pairs in fixed chunks, each chunk's contacts kept apart
+  // and merged in chunk order (space.cpp) ----
+  struct Hit {
+    Geometry *a, *b;
+    uint32_t begin, count;  // points in the chunk's buffer
+  };
+  struct Chunk {
+    std::vector<ContactPoint> points, scratch;
+    std::vector<Hit> hits;
+  };
+  std::vector<Chunk> chunks_;
+  bool parallelNarrowphase_ = false;
 };
 
 }  // namespace scree

@@ -117,6 +117,49 @@ struct PgsColouring {
   std::vector<Remap> remapped;
 };
 
+// ---- issue 18 (sweep scheduling): partitioned sweeps (pgs_partition.cpp, pgs.cpp end, docs/solver-internals.md
+// "Partitioned sweeps") ----
+/// A sweep schedule with few barriers: the units (one contact's or joint's rows) in one order plus split points.
+/// The movable bodies are cut into kRegions regions of about equal work by a plane (PgsSolver::partition);
+/// a unit whose movable bodies all lie in region r belongs to region r, a unit that touches two regions to the
+/// boundary. `order` holds region 0's units, region 1's, ..., then the boundary's, each group in the serial
+/// sweep's order; group g is [split[g], split[g + 1]) (split has kRegions + 2 entries, the last group being the
+/// boundary). Regions share no movable body, so they can be swept at the same time by different threads; the
+/// boundary is swept by one thread between barriers. The result does not depend on the thread count: on one
+/// thread the regions simply run one after the other. The schedule is data (an order of units and split points),
+/// independent of the row layout. Kept by the caller across steps (storage reused); the cut is kept while the
+/// units (their bodies and row counts, in order) stay the same as when it was made.
+struct PgsPartition {
+  static constexpr int kRegions = 2;
+  struct Unit {
+    uint32_t begin, count;
+  };
+  /// Input: the units in the serial sweep's order, and each solver body's position (for the cutting plane).
+  std::vector<Unit> units;
+  std::vector<Vec3> bodyPosition;
+  /// Output.
+  std::vector<Unit> order;
+  uint32_t split[kRegions + 2] = {};
+  std::vector<int8_t> bodyRegion;  ///< per solver body: its region, -1 for static and kinematic bodies
+  int axis = 0;                    ///< the cutting plane's normal (0 x, 1 y, 2 z)
+  // Scratch (reused).
+  std::vector<uint32_t> sortedBodies, tmp;
+  std::vector<Real> bodyWeight;
+  std::vector<int8_t> unitGroup;
+  std::vector<uint64_t> signature;  ///< the units' body pairs and row counts when the cut was last made
+  struct Remap {
+    uint32_t row;
+    int side;
+    int32_t body;
+  };
+  std::vector<Remap> remapped;
+  /// Shock pass (PgsSolver::shockPass with a partition): per range, the thread list it belongs to and how many
+  /// ranges of the other list must be finished before it runs.
+  std::vector<uint32_t> shockList[kRegions];
+  std::vector<uint32_t> shockWait[kRegions];
+  std::vector<uint32_t> shockDone;  ///< per solver body: 1 + position of its last writer in its region's list
+};
+
 class PgsSolver {
  public:
   /// Computes M^-1 J^T and the diagonals, then applies the warm-start impulses to the velocities. With `blocks`,
@@ -164,7 +207,29 @@ class PgsSolver {
   static void shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                         const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks = nullptr);
 
+  // ---- issue 18 (sweep scheduling): partitioned sweeps ----
+  /// Cuts `partition.units` into regions and a boundary (PgsPartition); call after prepare, every step.
+  static void partition(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                        PgsPartition& partition);
+  /// `iterations` partitioned sweeps (alternating forward and backward): forward, the regions (in parallel, or
+  /// one after the other on one thread), then the boundary; backward, the boundary, then the regions, each
+  /// unit's rows backward. Two barriers per pair of sweeps. Results do not depend on the number of threads.
+  static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
+                      const PgsBlocks* blocks, PgsPartition& partition);
+  /// The shock pass (same law and order of dependencies as shockPass above, bit-identical to it): the ranges of
+  /// each region's free bodies run on their own thread, waiting only for ranges of the other region whose free
+  /// body is their frozen one (point-to-point, no barrier).
+  static void shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                        const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks,
+                        PgsPartition& partition);
+
  private:
+  /// The cutting plane and the bodies' regions (pgs_partition.cpp).
+  static void cutRegions(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                         PgsPartition& partition);
+  /// One range of the shock pass swept to convergence (shockPass's per-range body).
+  static void shockRange(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                         const ShockRange& sr, int maxSweeps, const PgsBlocks* blocks);
   /// One support of the shock pass (a manifold's normal block and its centre friction rows) solved exactly on
   /// the free body when the solution lies inside the bounds (pgs.cpp); false: nothing changed, sweep it.
   static bool solveSupportExactly(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,

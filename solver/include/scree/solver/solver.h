@@ -146,6 +146,17 @@ class Solver {
   /// the rattling of its top rows (figures in the docs page); with the shock pass it changes little.
   void setUseFrictionAnchors(bool on) { frictionAnchors_ = on; }
   bool getUseFrictionAnchors() const { return frictionAnchors_; }
+  // ---- issue 18 (sweep scheduling): partitioned sweeps ----
+  /// Partitioned PGS sweeps and a parallel shock pass (default off; PgsPartition, docs/solver-internals.md
+  /// "Partitioned sweeps"): the dynamic bodies are cut by a plane into two regions of about equal work; the
+  /// contacts and joints inside each region are swept by their own thread, those across the cut by one thread
+  /// between barriers (one barrier per sweep instead of one per colour). The shock pass runs the supports of
+  /// each region on their own thread in the same dependency order (its result equals the serial pass's).
+  /// Results are bit-identical for any thread count (setNumThreads). The sweep order differs from the default
+  /// serial order (each region's contacts, then those across the cut), so trajectories differ from the
+  /// default's. Takes precedence over setUseColouredSweeps when both are on.
+  void setUsePartitionedSweeps(bool on) { partitionedSweeps_ = on; }
+  bool getUsePartitionedSweeps() const { return partitionedSweeps_; }
   const SolverStats& getStats() const { return stats_; }
 
  private:
@@ -168,6 +179,7 @@ class Solver {
   SolverStats stats_;
   bool colouredSweeps_ = false;  // issue 18 (sweep scheduling)
   bool frictionAnchors_ = false;  // issue 18 (friction anchors), opt-in
+  bool partitionedSweeps_ = false;  // issue 18 (sweep scheduling): partitioned sweeps
 };
 
 }  // namespace scree
