@@ -17,6 +17,19 @@ using namespace scree::detail;
 
 TEST_SUITE("coloured sweeps") {
 
+namespace {
+// Every body's position, velocity and angular velocity, and the top box's rotation: the state compared bit for bit.
+std::vector<Real> pyramidState(const scenes::PyramidScene& s) {
+  std::vector<Real> state;
+  for (const RigidBodyRef& b : s.sim->getRigidBodies())
+    for (const Vec3& v : {b->getPosition(), b->getVelocity(), b->getAngularVelocity()})
+      state.insert(state.end(), v.data(), v.data() + 3);
+  const Quat q = s.top->getRotation();
+  state.insert(state.end(), {q.w(), q.x(), q.y(), q.z()});
+  return state;
+}
+}  // namespace
+
 TEST_CASE("colouring: no colour holds two units that share a dynamic body; static bodies are shared freely") {
   // Bodies 0-3 dynamic, 4 static (zero inverse mass and inertia). Units of two rows each: four boxes on the
   // static ground and a chain 0-1-2-3 between them (degree 3 for the inner bodies: at least 3 colours).
@@ -66,13 +79,7 @@ TEST_CASE("coloured sweeps: pyramid20 is bit-identical on 1 and 2 threads and st
     s.sim->getSolver().setUseColouredSweeps(true);
     for (int i = 0; i < s.numSteps; ++i) s.step();
     setNumThreads(1);
-    std::vector<Real> state;
-    for (const RigidBodyRef& b : s.sim->getRigidBodies())
-      for (const Vec3& v : {b->getPosition(), b->getVelocity(), b->getAngularVelocity()})
-        state.insert(state.end(), v.data(), v.data() + 3);
-    const Quat q = s.top->getRotation();
-    state.insert(state.end(), {q.w(), q.x(), q.y(), q.z()});
-    return std::make_pair(state, scenes::measurePyramid(s));
+    return std::make_pair(pyramidState(s), scenes::measurePyramid(s));
   };
   const auto [one, m1] = run(1);
   setNumThreads(2);
@@ -154,13 +161,7 @@ std::pair<std::vector<Real>, scenes::PyramidMetrics> runPartitioned(int threads,
   s.sim->getSolver().setUseShockPropagation(shock);
   for (int i = 0; i < (steps > 0 ? steps : s.numSteps); ++i) s.step();
   setNumThreads(1);
-  std::vector<Real> state;
-  for (const RigidBodyRef& b : s.sim->getRigidBodies())
-    for (const Vec3& v : {b->getPosition(), b->getVelocity(), b->getAngularVelocity()})
-      state.insert(state.end(), v.data(), v.data() + 3);
-  const Quat q = s.top->getRotation();
-  state.insert(state.end(), {q.w(), q.x(), q.y(), q.z()});
-  return {state, scenes::measurePyramid(s)};
+  return {pyramidState(s), scenes::measurePyramid(s)};
 }
 }  // namespace
 
