@@ -264,10 +264,13 @@ void Simulation::stepForward() {
   int stage = 0;
   const auto start = Clock::now();
   uint64_t last = stageTicks();
-  const uint64_t first = last;
+  uint64_t allTicks = 0;
   auto mark = [&]() {
     const uint64_t now = stageTicks();
-    ticks[stage] = now - last;
+    // A thread moved to a core whose counter lags would see time run backwards: count that stage as 0 (the
+    // shares below stay within [0, total] and still add up to it).
+    ticks[stage] = now > last ? now - last : 0;
+    allTicks += ticks[stage];
     last = now;
   };
   auto timed = [&](auto&& run) {
@@ -306,7 +309,6 @@ void Simulation::stepForward() {
   s.time += s.h;
   timedUnlessIdle(s.stepListeners.empty(), [&] { runStepListeners(s, StepEventListener::POST_STEP); });
   timedUnlessIdle(noParticles, [&] { endParticleDeferral(s); });
-  const uint64_t allTicks = last - first;
   const auto end = Clock::now();
   t.total = std::chrono::duration<double>(end - start).count();
   const double perTick = allTicks > 0 ? t.total / double(allTicks) : 0.0;
