@@ -131,37 +131,62 @@ void Space::collide(Real h, std::vector<GeometryContact>& out) {
   // a steady scene), and the chunks are merged in order. Each pair's narrowphase reads only its two geometries
   // (transforms updated above), so the contacts -- and, after the sort below, their order -- are the same for
   // any thread count. Few pairs are not worth waking threads for; the result is the same either way.
+  //
+  // DESIGN (issue 18, fixed cost of small scenes; docs/benchmarks.md "Small scenes against Bullet"): without the
+  // parallel option (or with too few chunks) the pairs are collided in the same order on the calling thread,
+  // with no OpenMP region and no chunk buffers. An `omp parallel` region entered with `if (false)` still costs
+  // libgomp a team allocation, a free and a futex wake, and the chunk buffers cost one more copy of every
+  // contact point: together about 0.6 us of mass_ratio's 4.9 us step (its collide stage went 1.27 -> 0.68 us). Here each pair is collided into one scratch buffer that
+  // then trades storage with the contact's (a swap, no copy; the buffers keep their capacity, so a steady scene
+  // allocates nothing). Both paths give the same contacts in the same order.
   constexpr size_t kChunkPairs = 64;
   const size_t numChunks = (pairs_.size() + kChunkPairs - 1) / kChunkPairs;
-  if (chunks_.size() < numChunks) chunks_.resize(numChunks);
   const bool parallel = parallelNarrowphase_ && numChunks >= 4;
-#pragma omp parallel for schedule(dynamic, 1) if (parallel)
-  for (size_t c = 0; c < numChunks; ++c) {
-    Chunk& ch = chunks_[c];
-    ch.points.clear();
-    ch.hits.clear();
-    const size_t end = std::min(pairs_.size(), (c + 1) * kChunkPairs);
-    for (size_t k = c * kChunkPairs; k < end; ++k) {
-      const auto [i, j] = pairs_[k];
+  if (!parallel) {
+    for (const auto& [i, j] : pairs_) {
       Geometry* ga = geoms_[i].get();
       Geometry* gb = geoms_[j].get();
       if (!canCollide(*ga, *gb)) continue;
       const Real pairMargin = margins_[i] + margins_[j];
       if (ga->getId() > gb->getId()) std::swap(ga, gb);
-      ch.scratch.clear();
-      if (collideGeometries(*ga, *gb, pairMargin, ch.scratch) <= 0 || ch.scratch.empty()) continue;
-      ch.hits.push_back({ga, gb, uint32_t(ch.points.size()), uint32_t(ch.scratch.size())});
-      ch.points.insert(ch.points.end(), ch.scratch.begin(), ch.scratch.end());
-    }
-  }
-  for (size_t c = 0; c < numChunks; ++c) {
-    const Chunk& ch = chunks_[c];
-    for (const Hit& hit : ch.hits) {
+      serialScratch_.clear();
+      if (collideGeometries(*ga, *gb, pairMargin, serialScratch_) <= 0 || serialScratch_.empty()) continue;
       if (used == out.size()) out.emplace_back();
       GeometryContact& gc = out[used++];
-      gc.reset(hit.a, hit.b, hit.a->getRigidBody(), hit.b->getRigidBody());
-      gc.points().assign(ch.points.begin() + hit.begin, ch.points.begin() + hit.begin + hit.count);
-      gc.setSensor(hit.a->isSensor() || hit.b->isSensor());
+      gc.reset(ga, gb, ga->getRigidBody(), gb->getRigidBody());  // clears its points, keeps their storage
+      gc.points().swap(serialScratch_);
+      gc.setSensor(ga->isSensor() || gb->isSensor());
+    }
+  } else {
+    if (chunks_.size() < numChunks) chunks_.resize(numChunks);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (size_t c = 0; c < numChunks; ++c) {
+      Chunk& ch = chunks_[c];
+      ch.points.clear();
+      ch.hits.clear();
+      const size_t end = std::min(pairs_.size(), (c + 1) * kChunkPairs);
+      for (size_t k = c * kChunkPairs; k < end; ++k) {
+        const auto [i, j] = pairs_[k];
+        Geometry* ga = geoms_[i].get();
+        Geometry* gb = geoms_[j].get();
+        if (!canCollide(*ga, *gb)) continue;
+        const Real pairMargin = margins_[i] + margins_[j];
+        if (ga->getId() > gb->getId()) std::swap(ga, gb);
+        ch.scratch.clear();
+        if (collideGeometries(*ga, *gb, pairMargin, ch.scratch) <= 0 || ch.scratch.empty()) continue;
+        ch.hits.push_back({ga, gb, uint32_t(ch.points.size()), uint32_t(ch.scratch.size())});
+        ch.points.insert(ch.points.end(), ch.scratch.begin(), ch.scratch.end());
+      }
+    }
+    for (size_t c = 0; c < numChunks; ++c) {
+      const Chunk& ch = chunks_[c];
+      for (const Hit& hit : ch.hits) {
+        if (used == out.size()) out.emplace_back();
+        GeometryContact& gc = out[used++];
+        gc.reset(hit.a, hit.b, hit.a->getRigidBody(), hit.b->getRigidBody());
+        gc.points().assign(ch.points.begin() + hit.begin, ch.points.begin() + hit.begin + hit.count);
+        gc.setSensor(hit.a->isSensor() || hit.b->isSensor());
+      }
     }
   }
 

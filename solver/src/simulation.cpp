@@ -7,6 +7,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
+#if defined(__x86_64__) || defined(__i386__)
+#include <x86intrin.h>
+#endif
 
 #include "body_access.h"
 #include "scree/core/errors.h"
@@ -221,64 +225,97 @@ StepTimings Simulation::getTimings() const {
 
 // ---- the step ----------------------------------------------------------------------------------------------
 
+namespace {
+// DESIGN (issue 18, fixed cost of small scenes; docs/benchmarks.md "Small scenes against Bullet"): the stage
+// boundaries read a tick counter, the step's two ends the steady clock. On x86-64 the ticks are the time-stamp
+// counter (rdtsc: constant and non-stop on current CPUs; the kernel's own clock source reads it too): a
+// steady_clock read goes through the vDSO's clock_gettime (counter read, scaling, sequence lock) and cost about
+// 26 ns against 10 ns for rdtsc on this virtual machine; the 12 boundary reads of a rigid step were about 6 % of
+// a two-box step (mass_ratio). A stage's seconds are the step's steady-clock seconds times the stage's share of the step's
+// ticks, so the stages add up to `total` exactly and no tick rate has to be calibrated. Elsewhere the ticks are
+// the steady clock's own.
+using Clock = std::chrono::steady_clock;
+inline uint64_t stageTicks() {
+#if defined(__x86_64__) || defined(__i386__)
+  return __rdtsc();
+#else
+  return uint64_t(Clock::now().time_since_epoch().count());
+#endif
+}
+}  // namespace
+
 void Simulation::stepForward() {
   using namespace detail;
-  using Clock = std::chrono::steady_clock;
   SimulationState& s = *s_;
   StepStats& t = s.stats;
   s.report = StepReport{};
-  // One clock read per stage boundary: each stage's time runs from the end of the previous one. A stage that
-  // had nothing to do (no step listeners, no particles, no constraints) reads no clock and reports 0: its few
+  // One tick read per stage boundary: each stage's time runs from the end of the previous one. A stage that had
+  // nothing to do (no step listeners, no particles, no constraints) reads nothing and reports 0: its few
   // nanoseconds of checks go to the next stage. Clock reads were 11 % of a one-box step (slide: 20 reads of
   // about 25 ns in a 4.6 us step; docs/solver-internals.md "Fixed cost of small rigid scenes").
+  // The stages' tick counts, in stage order, are kept in `ticks` and turned into seconds at the end of the step.
+  double* const slots[] = {&t.preCollide,   &t.syncGeometries,  &t.collideGeometries, &t.collideParticles,
+                           &t.resolveMaterials, &t.contactEvents, &t.pre,             &t.applyForces,
+                           &t.contactRows,  &t.constraintRows,  &t.particleRows,      &t.solve,
+                           &t.integrateMotion, &t.storeResults,  &t.projectPositions,  &t.checkFinite,
+                           &t.post,         &t.compactParticles};
+  constexpr int kStages = int(sizeof(slots) / sizeof(slots[0]));
+  uint64_t ticks[kStages] = {};
+  int stage = 0;
   const auto start = Clock::now();
-  auto last = start;
-  auto timed = [&last](double& seconds, auto&& stage) {
-    stage();
-    const auto now = Clock::now();
-    seconds = std::chrono::duration<double>(now - last).count();
+  uint64_t last = stageTicks();
+  uint64_t allTicks = 0;
+  auto mark = [&]() {
+    const uint64_t now = stageTicks();
+    // A thread moved to a core whose counter lags would see time run backwards: count that stage as 0 (the
+    // shares below stay within [0, total] and still add up to it).
+    ticks[stage] = now > last ? now - last : 0;
+    allTicks += ticks[stage];
     last = now;
   };
-  auto timedUnlessIdle = [&timed](bool idle, double& seconds, auto&& stage) {
-    if (!idle) return timed(seconds, stage);
-    stage();
-    seconds = 0;
+  auto timed = [&](auto&& run) {
+    run();
+    mark();
+    ++stage;
   };
   // Idle tests are evaluated before their stage runs (a listener may add listeners or constraints).
-  timedUnlessIdle(s.stepListeners.empty(), t.preCollide, [&] { runStepListeners(s, StepEventListener::PRE_COLLIDE); });
-  timed(t.syncGeometries, [&] { syncGeometries(s); });
-  timed(t.collideGeometries, [&] { collideGeometries(s); });
+  auto timedUnlessIdle = [&](bool idle, auto&& run) {
+    run();
+    if (!idle) mark();
+    ++stage;
+  };
+  // The order of these calls is the order of `slots`.
+  timedUnlessIdle(s.stepListeners.empty(), [&] { runStepListeners(s, StepEventListener::PRE_COLLIDE); });
+  timed([&] { syncGeometries(s); });
+  timed([&] { collideGeometries(s); });
   // collideParticles decides whether this is a granular step (s.granularStep); the later particle stages
   // do nothing without one.
   collideParticles(s);
-  if (s.granularStep) {
-    const auto now = Clock::now();
-    t.collideParticles = std::chrono::duration<double>(now - last).count();
-    last = now;
-  } else {
-    t.collideParticles = 0;
-  }
+  if (s.granularStep) mark();  // otherwise its checks count to the next stage
+  ++stage;
   const bool noParticles = !s.granularStep;
-  timed(t.resolveMaterials, [&] { resolveContactMaterials(s); });
-  timed(t.contactEvents, [&] { runContactEvents(s); });
-  timedUnlessIdle(s.stepListeners.empty(), t.pre, [&] { runStepListeners(s, StepEventListener::PRE_STEP); });
-  timed(t.applyForces, [&] { applyForces(s); });
-  timed(t.contactRows, [&] { buildContactRows(s); });
-  timedUnlessIdle(s.constraints.empty(), t.constraintRows, [&] { buildConstraintRows(s); });
-  timedUnlessIdle(noParticles, t.particleRows, [&] { buildParticleRows(s); });
-  timed(t.solve, [&] { solve(s); });
-  timed(t.integrateMotion, [&] { integrateMotion(s); });
-  timed(t.storeResults, [&] { storeResults(s); });
-  timedUnlessIdle(s.ranges.empty(), t.projectPositions, [&] { projectPositions(s); });
-  timed(t.checkFinite, [&] { checkFinite(s); });
+  timed([&] { resolveContactMaterials(s); });
+  timed([&] { runContactEvents(s); });
+  timedUnlessIdle(s.stepListeners.empty(), [&] { runStepListeners(s, StepEventListener::PRE_STEP); });
+  timed([&] { applyForces(s); });
+  timed([&] { buildContactRows(s); });
+  timedUnlessIdle(s.constraints.empty(), [&] { buildConstraintRows(s); });
+  timedUnlessIdle(noParticles, [&] { buildParticleRows(s); });
+  timed([&] { solve(s); });
+  timed([&] { integrateMotion(s); });
+  timed([&] { storeResults(s); });
+  timedUnlessIdle(s.ranges.empty(), [&] { projectPositions(s); });
+  timed([&] { checkFinite(s); });
   s.time += s.h;
-  timedUnlessIdle(s.stepListeners.empty(), t.post,
-                  [&] { runStepListeners(s, StepEventListener::POST_STEP); });
-  timedUnlessIdle(noParticles, t.compactParticles, [&] { endParticleDeferral(s); });
+  timedUnlessIdle(s.stepListeners.empty(), [&] { runStepListeners(s, StepEventListener::POST_STEP); });
+  timedUnlessIdle(noParticles, [&] { endParticleDeferral(s); });
+  const auto end = Clock::now();
+  t.total = std::chrono::duration<double>(end - start).count();
+  const double perTick = allTicks > 0 ? t.total / double(allTicks) : 0.0;
+  for (int k = 0; k < kStages; ++k) *slots[k] = double(ticks[k]) * perTick;
   t.collide = t.syncGeometries + t.collideGeometries + t.collideParticles + t.resolveMaterials;
   t.rows = t.applyForces + t.contactRows + t.constraintRows + t.particleRows;
   t.integrate = t.integrateMotion + t.storeResults + t.projectPositions + t.checkFinite;
-  t.total = std::chrono::duration<double>(last - start).count();
 }
 
 void Simulation::stepTo(Real time) {

@@ -82,6 +82,9 @@ class Space {
   };
   std::vector<Chunk> chunks_;
   bool parallelNarrowphase_ = false;
+  // ---- issue 18 (fixed cost of small scenes): the serial narrowphase's one scratch buffer, whose storage is
+  // swapped into each touching pair's contact (space.cpp) ----
+  std::vector<ContactPoint> serialScratch_;
 };
 
 }  // namespace scree
