@@ -578,22 +578,46 @@ size_t unitSpan(const std::vector<ConstraintRow>& rows, size_t i) {
   return 1;
 }
 
-void buildCompact(const std::vector<ConstraintRow>& rows, PgsBlocks& pb) {
+/// The compact layout's extra conditions (pgs.h PgsBlocks::Manifold) on a manifold of the compact form:
+/// J_linB = -J_linA on the tangent rows and the block centre, no linear part on the twist row nor (to 1e-12 of
+/// the centre's) on the tilt coordinates, one compliance and no upper bound on the normal rows. contact_rows.cpp
+/// builds its manifolds so; anything else keeps the ConstraintRow sweeps.
+bool fitsCompactLayout(const std::vector<ConstraintRow>& rows, size_t i, int n, const PgsBlocks::Block& B) {
+  for (size_t k = 0; k < 2; ++k)
+    if (rows[i + k].jLinB != -rows[i + k].jLinA) return false;
+  if (!rows[i + 2].jLinA.isZero(0) || !rows[i + 2].jLinB.isZero(0)) return false;
+  if (B.gLinB[0] != -B.gLinA[0]) return false;
+  const Real tol = 1e-12 * B.gLinA[0].norm();
+  for (int a = 1; a < 3; ++a)
+    if (B.gLinA[a].norm() > tol || B.gLinB[a].norm() > tol) return false;
+  const Real e = rows[i + 3].e;
+  for (int k = 0; k < n; ++k) {
+    const ConstraintRow& r = rows[i + 3 + size_t(k)];
+    if (r.e != e || r.hi < 1e300) return false;
+  }
+  return true;
+}
+
+void buildCompact(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                  PgsBlocks& pb) {
   pb.manifolds.clear();
   pb.points.clear();
   pb.plan.clear();
   size_t runBegin = 0;
   for (size_t i = 0; i < rows.size();) {
     int n = 0;
-    if (!isCompactManifold(rows, i, n)) {
+    if (!isCompactManifold(rows, i, n) ||
+        !fitsCompactLayout(rows, i, n, pb.blocks[size_t(rows[i + 3].blockSlot)])) {
       i += unitSpan(rows, i);
       continue;
     }
     if (runBegin < i) pb.plan.push_back({uint32_t(runBegin), uint32_t(i), -1});
-    PgsBlocks::Manifold m;
+    PgsBlocks::Manifold& m = pb.manifolds.emplace_back();
     const ConstraintRow& t1 = rows[i];
     m.a = t1.bodyA;
     m.b = t1.bodyB;
+    m.imA = m.a >= 0 ? bodies[size_t(m.a)].invMass : 0.0;
+    m.imB = m.b >= 0 ? bodies[size_t(m.b)].invMass : 0.0;
     m.row = uint32_t(i);
     m.block = uint32_t(rows[i + 3].blockSlot);
     m.point = uint32_t(pb.points.size());
@@ -603,34 +627,32 @@ void buildCompact(const std::vector<ConstraintRow>& rows, PgsBlocks& pb) {
     m.muTwist = rows[i + 2].mu;
     for (int k = 0; k < 3; ++k) {
       const ConstraintRow& r = rows[i + size_t(k)];
-      PgsBlocks::FrictionRow& f = m.f[k];
-      f.jA << r.jLinA, r.jAngA;
-      f.jB << r.jLinB, r.jAngB;
-      f.wA << r.mJLinA, r.mJAngA;
-      f.wB << r.mJLinB, r.mJAngB;
-      f.rhs = r.rhs;
-      f.e = r.e;
-      f.invDiag = r.invDiag;
-      f.lambda = r.lambda;
+      m.ang[3 + k] << r.jAngA, r.jAngB;
+      m.w[3 + k] << r.mJAngA, r.mJAngB;
+      m.rhs[k] = r.rhs;
+      m.e[k] = r.e;
+      m.invDiag[k] = r.invDiag;
+      m.lambda[k] = r.lambda;
     }
+    m.lin[1] = rows[i].jLinA;
+    m.lin[2] = rows[i + 1].jLinA;
     const PgsBlocks::Block& B = pb.blocks[m.block];
+    m.lin[0] = B.gLinA[0];
     for (int a = 0; a < 3; ++a) {
-      m.gA[a] << B.gLinA[a], B.gAngA[a];
-      m.gB[a] << B.gLinB[a], B.gAngB[a];
-      m.wA[a] << B.wLinA[a], B.wAngA[a];
-      m.wB[a] << B.wLinB[a], B.wAngB[a];
+      m.ang[a] << B.gAngA[a], B.gAngB[a];
+      m.w[a] << B.wAngA[a], B.wAngB[a];
       m.dRhs[a] = B.dRhs[a];
     }
     for (int k = 0; k < 6; ++k) m.sInv[k] = B.sInv[0][k];
     m.ok = B.ok[0];
     m.axisU = B.axisU;
     m.axisV = B.axisV;
+    m.eN = rows[i + 3].e;
     for (int k = 0; k < n; ++k) {
       const ConstraintRow& r = rows[i + 3 + size_t(k)];
-      pb.points.push_back({r.blockU, r.blockV, r.e, r.lambda, r.lo, r.hi});
+      pb.points.push_back({r.blockU, r.blockV, r.lambda, r.lo});
     }
-    pb.plan.push_back({uint32_t(i), uint32_t(i) + 3 + uint32_t(n), int32_t(pb.manifolds.size())});
-    pb.manifolds.push_back(m);
+    pb.plan.push_back({uint32_t(i), uint32_t(i) + 3 + uint32_t(n), int32_t(pb.manifolds.size() - 1)});
     i += 3 + size_t(n);
     runBegin = i;
   }
@@ -639,20 +661,12 @@ void buildCompact(const std::vector<ConstraintRow>& rows, PgsBlocks& pb) {
 
 void writeBackCompact(std::vector<ConstraintRow>& rows, const PgsBlocks& pb) {
   for (const PgsBlocks::Manifold& m : pb.manifolds) {
-    for (int k = 0; k < 3; ++k) rows[m.row + uint32_t(k)].lambda = m.f[k].lambda;
+    for (int k = 0; k < 3; ++k) rows[m.row + uint32_t(k)].lambda = m.lambda[k];
     for (int k = 0; k < m.n; ++k) rows[m.row + 3 + uint32_t(k)].lambda = pb.points[m.point + uint32_t(k)].lambda;
   }
 }
 
-// A solver body's (v, w) as one Vec6 (SolverBodyState keeps w right after v).
-static_assert(offsetof(SolverBodyState, w) == 3 * sizeof(Real));
 using Vec6 = PgsBlocks::Vec6;
-inline Eigen::Map<Vec6> velocity(std::vector<SolverBodyState>& b, int32_t i) {
-  return Eigen::Map<Vec6>(b[size_t(i)].v.data());
-}
-inline Eigen::Map<const Vec6> velocity(const std::vector<SolverBodyState>& b, int32_t i) {
-  return Eigen::Map<const Vec6>(b[size_t(i)].v.data());
-}
 
 /// The friction rows' bound: mu times the sum of the manifold's positive normal impulses (boundingNormal).
 inline Real compactNormalSum(const PgsBlocks::Point* P, int n) {
@@ -662,19 +676,47 @@ inline Real compactNormalSum(const PgsBlocks::Point* P, int n) {
 }
 
 /// The two bodies' velocities during one manifold visit. Every row of a manifold acts on the same two bodies, so
-/// a visit reads their (v, w) once into registers and stores them once; a static side reads as zero and is never
-/// stored (its W is zero, so the rows leave its local copy at zero).
+/// a visit reads their velocities once into registers and stores them once: the linear ones apart (the rows'
+/// linear parts act on v_A - v_B), the angular ones as one 6-vector (w_A; w_B) against the rows' [A; B] angular
+/// parts. A static side reads as zero and is never stored (its inverse mass and I^-1 J are zero, so the rows
+/// leave its local copy at zero).
 struct VisitBodies {
-  Vec6 a, b;
+  Vec3 vA, vB;
+  Vec6 w;
   bool hasA, hasB;
   VisitBodies(const PgsBlocks::Manifold& m, const std::vector<SolverBodyState>& bodies)
       : hasA(m.a >= 0), hasB(m.b >= 0) {
-    a = hasA ? Vec6(velocity(bodies, m.a)) : Vec6::Zero();
-    b = hasB ? Vec6(velocity(bodies, m.b)) : Vec6::Zero();
+    if (hasA) {
+      vA = bodies[size_t(m.a)].v;
+      w.head<3>() = bodies[size_t(m.a)].w;
+    } else {
+      vA.setZero();
+      w.head<3>().setZero();
+    }
+    if (hasB) {
+      vB = bodies[size_t(m.b)].v;
+      w.tail<3>() = bodies[size_t(m.b)].w;
+    } else {
+      vB.setZero();
+      w.tail<3>().setZero();
+    }
   }
   void store(const PgsBlocks::Manifold& m, std::vector<SolverBodyState>& bodies) const {
-    if (hasA) velocity(bodies, m.a) = a;
-    if (hasB) velocity(bodies, m.b) = b;
+    if (hasA) {
+      bodies[size_t(m.a)].v = vA;
+      bodies[size_t(m.a)].w = w.head<3>();
+    }
+    if (hasB) {
+      bodies[size_t(m.b)].v = vB;
+      bodies[size_t(m.b)].w = w.tail<3>();
+    }
+  }
+  /// J v of a row with A-side linear part l and angular part [A; B] ang.
+  Real rowVelocity(const Vec3& l, const Vec6& ang) const { return l.dot(vA - vB) + ang.dot(w); }
+  /// The linear velocity change of an impulse d along the A-side direction l.
+  void push(const PgsBlocks::Manifold& m, const Vec3& l, Real d) {
+    vA += (m.imA * d) * l;
+    vB -= (m.imB * d) * l;
   }
 };
 
@@ -683,30 +725,32 @@ Real compactFriction(PgsBlocks::Manifold& m, const PgsBlocks::Point* P, VisitBod
   Real maxDelta = 0;
   // The normal impulses do not change during the friction rows' visit: their sum is formed once.
   const Real sumN = compactNormalSum(P, m.n);
+  // Row k (0 t1, 1 t2, 2 twist: no linear part).
+  auto velocity = [&](int k) {
+    return k < 2 ? V.rowVelocity(m.lin[1 + k], m.ang[3 + k]) : m.ang[5].dot(V.w);
+  };
   auto scalar = [&](int k, Real mu) {
-    PgsBlocks::FrictionRow& f = m.f[k];
     const Real lim = frictionLimit(mu, sumN);
-    const Real delta = (f.rhs - (f.jA.dot(V.a) + f.jB.dot(V.b)) - f.e * f.lambda) * f.invDiag;
-    const Real nl = std::clamp(f.lambda + delta, -lim, lim);
-    const Real d = nl - f.lambda;
-    f.lambda = nl;
-    V.a += f.wA * d;
-    V.b += f.wB * d;
+    const Real delta = (m.rhs[k] - velocity(k) - m.e[k] * m.lambda[k]) * m.invDiag[k];
+    const Real nl = std::clamp(m.lambda[k] + delta, -lim, lim);
+    const Real d = nl - m.lambda[k];
+    m.lambda[k] = nl;
+    V.w += m.w[3 + k] * d;
+    if (k < 2) V.push(m, m.lin[1 + k], d);
     maxDelta = std::max(maxDelta, std::abs(d));
   };
   auto pair = [&]() {
-    PgsBlocks::FrictionRow& r = m.f[0];
-    PgsBlocks::FrictionRow& s = m.f[1];
-    Real d1 = (r.rhs - (r.jA.dot(V.a) + r.jB.dot(V.b)) - r.e * r.lambda) * r.invDiag;
-    Real d2 = (s.rhs - (s.jA.dot(V.a) + s.jB.dot(V.b)) - s.e * s.lambda) * s.invDiag;
-    Real l1 = r.lambda + d1, l2 = s.lambda + d2;
+    Real d1 = (m.rhs[0] - velocity(0) - m.e[0] * m.lambda[0]) * m.invDiag[0];
+    Real d2 = (m.rhs[1] - velocity(1) - m.e[1] * m.lambda[1]) * m.invDiag[1];
+    Real l1 = m.lambda[0] + d1, l2 = m.lambda[1] + d2;
     projectOntoDisc(l1, l2, frictionLimit(m.mu, sumN));
-    d1 = l1 - r.lambda;
-    d2 = l2 - s.lambda;
-    r.lambda = l1;
-    s.lambda = l2;
-    V.a += r.wA * d1 + s.wA * d2;
-    V.b += r.wB * d1 + s.wB * d2;
+    d1 = l1 - m.lambda[0];
+    d2 = l2 - m.lambda[1];
+    m.lambda[0] = l1;
+    m.lambda[1] = l2;
+    V.w += m.w[3] * d1 + m.w[4] * d2;
+    const Vec3 dl = m.lin[1] * d1 + m.lin[2] * d2;
+    V.push(m, dl, 1.0);
     maxDelta = std::max(maxDelta, std::max(std::abs(d1), std::abs(d2)));
   };
   if (forward) {
@@ -735,16 +779,17 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
   PgsBlocks::Point* P = pb.points.data() + m.point;
   const int n = m.n;
   if (m.ok) {
-    Real b[3];
-    for (int a = 0; a < 3; ++a) b[a] = m.dRhs[a] - (m.gA[a].dot(V.a) + m.gB[a].dot(V.b));
+    // The points' compliance is one per block: the sums of lambda, lambda u and lambda v carry its term.
+    Real sl = 0, slu = 0, slv = 0;
     for (int i = 0; i < n; ++i) {
-      const Real el = P[i].e * P[i].lambda;
-      b[0] -= el;
-      b[1] -= el * P[i].u;
-      b[2] -= el * P[i].v;
+      sl += P[i].lambda;
+      slu += P[i].lambda * P[i].u;
+      slv += P[i].lambda * P[i].v;
     }
-    if (!m.axisU) b[1] = 0;
-    if (!m.axisV) b[2] = 0;
+    Real b[3];
+    b[0] = m.dRhs[0] - V.rowVelocity(m.lin[0], m.ang[0]) - m.eN * sl;
+    b[1] = m.axisU ? m.dRhs[1] - m.ang[1].dot(V.w) - m.eN * slu : 0.0;
+    b[2] = m.axisV ? m.dRhs[2] - m.ang[2].dot(V.w) - m.eN * slv : 0.0;
     const Real* Si = m.sInv;
     Real dmu[3];
     dmu[0] = Si[0] * b[0] + Si[1] * b[1] + Si[3] * b[2];
@@ -755,8 +800,7 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
       bool inside = true;
       for (int i = 0; i < n; ++i) {
         dl[i] = dmu[0] + dmu[1] * P[i].u + dmu[2] * P[i].v;
-        const Real nl = P[i].lambda + dl[i];
-        inside &= nl >= P[i].lo && nl <= P[i].hi;
+        inside &= P[i].lambda + dl[i] >= P[i].lo;
       }
       if (inside) {
         Real maxD = 0;
@@ -764,8 +808,8 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
           P[i].lambda += dl[i];
           maxD = std::max(maxD, std::abs(dl[i]));
         }
-        V.a += m.wA[0] * dmu[0] + m.wA[1] * dmu[1] + m.wA[2] * dmu[2];
-        V.b += m.wB[0] * dmu[0] + m.wB[1] * dmu[1] + m.wB[2] * dmu[2];
+        V.w += m.w[0] * dmu[0] + m.w[1] * dmu[1] + m.w[2] * dmu[2];
+        V.push(m, m.lin[0], dmu[0]);
         return maxD;
       }
     }
@@ -799,7 +843,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     for (int it = 0; it < iterations; ++it) maxDelta = sweepRows(rows, bodies, 0, rows.size(), it % 2 == 0, blocks);
     return maxDelta;
   }
-  buildCompact(rows, *blocks);
+  buildCompact(rows, bodies, *blocks);
   const std::vector<PgsBlocks::Unit>& plan = blocks->plan;
   auto visit = [&](const PgsBlocks::Unit& u, bool forward) -> Real {
     if (u.manifold < 0) return sweepRows(rows, bodies, u.begin, u.end, forward, blocks);
@@ -986,24 +1030,28 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   const PgsBlocks::Point* P = pb.points.data() + m.point;
   ConstraintRow* F = rows.data() + m.row;
   ConstraintRow* R = F + 3;
-  const Vec6* G[kM];
-  const Vec6* W[kM];
-  for (int a = 0; a < 3; ++a) {
-    G[a] = freeA ? &m.gA[a] : &m.gB[a];
-    W[a] = freeA ? &m.wA[a] : &m.wB[a];
-    G[3 + a] = freeA ? &m.f[a].jA : &m.f[a].jB;
-    W[3 + a] = freeA ? &m.f[a].wA : &m.f[a].wB;
+  // The six rows on the free body (rows 0..2 the block's coordinates, 3..5 the friction rows): G = [lin; ang],
+  // W = M^-1 G^T. The B side's linear part is the A side's negated (pgs.h PgsBlocks::Manifold).
+  const Real sign = freeA ? 1.0 : -1.0, im = freeA ? m.imA : m.imB;
+  const int side = freeA ? 0 : 3;
+  Vec3 gl[kM], ga[kM], wl[kM], wa[kM];
+  for (int k = 0; k < kM; ++k) {
+    const Vec3 l = k == 0 ? m.lin[0] : k == 3 ? m.lin[1] : k == 4 ? m.lin[2] : Vec3::Zero().eval();
+    gl[k] = sign * l;
+    wl[k] = (sign * im) * l;
+    ga[k] = m.ang[k].segment<3>(side);
+    wa[k] = m.w[k].segment<3>(side);
   }
   Eigen::Matrix<Real, kM, kM> K;
   for (int a = 0; a < kM; ++a)
-    for (int c = 0; c <= a; ++c) K(a, c) = K(c, a) = G[a]->dot(*W[c]);
-  // Regularisation: the block's D E D^T, the friction rows' own e.
+    for (int c = 0; c <= a; ++c) K(a, c) = K(c, a) = gl[a].dot(wl[c]) + ga[a].dot(wa[c]);
+  // Regularisation: the block's D E D^T (one compliance per block), the friction rows' own e.
   Real dE[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   Real b[kM];
   for (int a = 0; a < 3; ++a) b[a] = m.dRhs[a];
   for (int i = 0; i < n; ++i) {
     const Real D[3] = {1.0, P[i].u, P[i].v};
-    const Real e = P[i].e, el = e * R[i].lambda;
+    const Real e = m.eN, el = e * R[i].lambda;
     for (int a = 0; a < 3; ++a) {
       b[a] -= D[a] * el;
       for (int c = 0; c < 3; ++c) dE[a][c] += D[a] * e * D[c];
@@ -1011,21 +1059,16 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   }
   for (int a = 0; a < 3; ++a)
     for (int c = 0; c < 3; ++c) K(a, c) += dE[a][c];
-  for (int k = 0; k < 3; ++k) K(3 + k, 3 + k) += m.f[k].e;
+  for (int k = 0; k < 3; ++k) K(3 + k, 3 + k) += m.e[k];
   // Residuals (velocities of both bodies, as in the sweeps).
-  if (m.a >= 0) {
-    const Vec6 V = velocity(bodies, m.a);
-    for (int a = 0; a < 3; ++a) b[a] -= m.gA[a].dot(V);
-    for (int k = 0; k < 3; ++k) b[3 + k] = m.f[k].rhs - m.f[k].jA.dot(V);
-  } else {
-    for (int k = 0; k < 3; ++k) b[3 + k] = m.f[k].rhs;
-  }
-  if (m.b >= 0) {
-    const Vec6 V = velocity(bodies, m.b);
-    for (int a = 0; a < 3; ++a) b[a] -= m.gB[a].dot(V);
-    for (int k = 0; k < 3; ++k) b[3 + k] -= m.f[k].jB.dot(V);
-  }
-  for (int k = 0; k < 3; ++k) b[3 + k] -= m.f[k].e * F[k].lambda;
+  const VisitBodies V(m, bodies);
+  b[0] -= V.rowVelocity(m.lin[0], m.ang[0]);
+  b[1] -= m.ang[1].dot(V.w);
+  b[2] -= m.ang[2].dot(V.w);
+  b[3] = m.rhs[0] - V.rowVelocity(m.lin[1], m.ang[3]);
+  b[4] = m.rhs[1] - V.rowVelocity(m.lin[2], m.ang[4]);
+  b[5] = m.rhs[2] - m.ang[5].dot(V.w);
+  for (int k = 0; k < 3; ++k) b[3 + k] -= m.e[k] * F[k].lambda;
   // A degenerate axis carries nothing (as in the block).
   for (int a = 1; a < 3; ++a)
     if (!(a == 1 ? m.axisU : m.axisV)) {
@@ -1043,7 +1086,7 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   Real sumN = 0;
   for (int i = 0; i < n; ++i) {
     nl[i] = R[i].lambda + x[0] + x[1] * P[i].u + x[2] * P[i].v;
-    if (nl[i] < P[i].lo || nl[i] > P[i].hi) return false;
+    if (nl[i] < P[i].lo) return false;
     sumN += std::max<Real>(nl[i], 0);
   }
   Real fl[3];
@@ -1057,9 +1100,13 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   if (std::abs(fl[2]) > frictionLimit(m.muTwist, sumN)) return false;
   for (int i = 0; i < n; ++i) R[i].lambda = nl[i];
   for (int k = 0; k < 3; ++k) F[k].lambda = fl[k];
-  Vec6 dV = Vec6::Zero();
-  for (int a = 0; a < kM; ++a) dV += *W[a] * x[a];
-  velocity(bodies, fb) += dV;
+  Vec3 dv = Vec3::Zero(), dw = Vec3::Zero();
+  for (int a = 0; a < kM; ++a) {
+    dv += wl[a] * x[a];
+    dw += wa[a] * x[a];
+  }
+  bodies[size_t(fb)].v += dv;
+  bodies[size_t(fb)].w += dw;
   return true;
 }
 
