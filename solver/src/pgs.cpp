@@ -200,14 +200,18 @@ static void buildBlock(const ConstraintRow* R, const std::vector<SolverBodyState
   }
   // S = D (K + E) D^T = G_a . W_c (over the free bodies) + sum_i D_ai e_i D_ci: the parts of body A, of body B
   // and of E once (symmetric), then summed per configuration.
-  Real SA[3][3], SB[3][3], SE[3][3];
+  Real SA[3][3], SB[3][3], SE[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  // E's part in one pass over the points (each entry summed in the points' order, as before).
+  for (int i = 0; i < n; ++i) {
+    const Real D[3] = {1.0, R[i].blockU, R[i].blockV};
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c <= a; ++c) SE[a][c] += D[a] * R[i].e * D[c];
+  }
   for (int a = 0; a < 3; ++a)
     for (int c = 0; c <= a; ++c) {
       SA[a][c] = SA[c][a] = hasA ? B.gLinA[a].dot(B.wLinA[c]) + B.gAngA[a].dot(B.wAngA[c]) : 0.0;
       SB[a][c] = SB[c][a] = hasB ? B.gLinB[a].dot(B.wLinB[c]) + B.gAngB[a].dot(B.wAngB[c]) : 0.0;
-      Real e = 0;
-      for (int i = 0; i < n; ++i) e += blockD(R[i], a) * R[i].e * blockD(R[i], c);
-      SE[a][c] = SE[c][a] = e;
+      SE[c][a] = SE[a][c];
     }
   for (int cfg = 0; cfg < 3; ++cfg) {
     const bool useA = cfg != 1, useB = cfg != 2;
@@ -598,6 +602,22 @@ bool fitsCompactLayout(const std::vector<ConstraintRow>& rows, size_t i, int n, 
   return true;
 }
 
+/// The manifold's sums over its points' normal impulses (PgsBlocks::Manifold::sl), from the points.
+void updateSums(PgsBlocks::Manifold& m, const PgsBlocks::Point* P) {
+  Real sl = 0, slu = 0, slv = 0, pos = 0;
+  for (int i = 0; i < m.n; ++i) {
+    const Real l = P[i].lambda;
+    sl += l;
+    slu += l * P[i].u;
+    slv += l * P[i].v;
+    pos += std::max<Real>(l, 0);
+  }
+  m.sl = sl;
+  m.slu = slu;
+  m.slv = slv;
+  m.sumN = pos;
+}
+
 void buildCompact(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
                   PgsBlocks& pb) {
   pb.manifolds.clear();
@@ -652,6 +672,7 @@ void buildCompact(const std::vector<ConstraintRow>& rows, const std::vector<Solv
       const ConstraintRow& r = rows[i + 3 + size_t(k)];
       pb.points.push_back({r.blockU, r.blockV, r.lambda, r.lo});
     }
+    updateSums(m, pb.points.data() + m.point);
     pb.plan.push_back({uint32_t(i), uint32_t(i) + 3 + uint32_t(n), int32_t(pb.manifolds.size() - 1)});
     i += 3 + size_t(n);
     runBegin = i;
@@ -668,12 +689,6 @@ void writeBackCompact(std::vector<ConstraintRow>& rows, const PgsBlocks& pb) {
 
 using Vec6 = PgsBlocks::Vec6;
 
-/// The friction rows' bound: mu times the sum of the manifold's positive normal impulses (boundingNormal).
-inline Real compactNormalSum(const PgsBlocks::Point* P, int n) {
-  Real sum = 0;
-  for (int k = 0; k < n; ++k) sum += std::max<Real>(P[k].lambda, 0);
-  return sum;
-}
 
 /// The two bodies' velocities during one manifold visit. Every row of a manifold acts on the same two bodies, so
 /// a visit reads their velocities once into registers and stores them once: the linear ones apart (the rows'
@@ -721,10 +736,10 @@ struct VisitBodies {
 };
 
 /// The friction rows of a compact manifold, forward (t1/t2, twist) or backward (twist, t2/t1); solveUnit's law.
-Real compactFriction(PgsBlocks::Manifold& m, const PgsBlocks::Point* P, VisitBodies& V, bool forward) {
+Real compactFriction(PgsBlocks::Manifold& m, VisitBodies& V, bool forward) {
   Real maxDelta = 0;
-  // The normal impulses do not change during the friction rows' visit: their sum is formed once.
-  const Real sumN = compactNormalSum(P, m.n);
+  // The bound's sum of positive normal impulses, kept with the impulses (boundingNormal's sum).
+  const Real sumN = m.sumN;
   // Row k (0 t1, 1 t2, 2 twist: no linear part).
   auto velocity = [&](int k) {
     return k < 2 ? V.rowVelocity(m.lin[1 + k], m.ang[3 + k]) : m.ang[5].dot(V.w);
@@ -779,17 +794,12 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
   PgsBlocks::Point* P = pb.points.data() + m.point;
   const int n = m.n;
   if (m.ok) {
-    // The points' compliance is one per block: the sums of lambda, lambda u and lambda v carry its term.
-    Real sl = 0, slu = 0, slv = 0;
-    for (int i = 0; i < n; ++i) {
-      sl += P[i].lambda;
-      slu += P[i].lambda * P[i].u;
-      slv += P[i].lambda * P[i].v;
-    }
+    // The points' compliance is one per block: the sums of lambda, lambda u and lambda v (kept with the
+    // impulses) carry its term.
     Real b[3];
-    b[0] = m.dRhs[0] - V.rowVelocity(m.lin[0], m.ang[0]) - m.eN * sl;
-    b[1] = m.axisU ? m.dRhs[1] - m.ang[1].dot(V.w) - m.eN * slu : 0.0;
-    b[2] = m.axisV ? m.dRhs[2] - m.ang[2].dot(V.w) - m.eN * slv : 0.0;
+    b[0] = m.dRhs[0] - V.rowVelocity(m.lin[0], m.ang[0]) - m.eN * m.sl;
+    b[1] = m.axisU ? m.dRhs[1] - m.ang[1].dot(V.w) - m.eN * m.slu : 0.0;
+    b[2] = m.axisV ? m.dRhs[2] - m.ang[2].dot(V.w) - m.eN * m.slv : 0.0;
     const Real* Si = m.sInv;
     Real dmu[3];
     dmu[0] = Si[0] * b[0] + Si[1] * b[1] + Si[3] * b[2];
@@ -803,11 +813,19 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
         inside &= P[i].lambda + dl[i] >= P[i].lo;
       }
       if (inside) {
-        Real maxD = 0;
+        Real maxD = 0, sl = 0, slu = 0, slv = 0, pos = 0;
         for (int i = 0; i < n; ++i) {
-          P[i].lambda += dl[i];
+          const Real l = P[i].lambda += dl[i];
           maxD = std::max(maxD, std::abs(dl[i]));
+          sl += l;
+          slu += l * P[i].u;
+          slv += l * P[i].v;
+          pos += std::max<Real>(l, 0);
         }
+        m.sl = sl;
+        m.slu = slu;
+        m.slv = slv;
+        m.sumN = pos;
         V.w += m.w[0] * dmu[0] + m.w[1] * dmu[1] + m.w[2] * dmu[2];
         V.push(m, m.lin[0], dmu[0]);
         return maxD;
@@ -828,6 +846,7 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
     for (size_t k = first + size_t(n); k-- > first;) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
   }
   for (int i = 0; i < n; ++i) P[i].lambda = rows[first + size_t(i)].lambda;
+  updateSums(m, P);
   V = VisitBodies(m, bodies);
   return maxDelta;
 }
@@ -848,15 +867,14 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   auto visit = [&](const PgsBlocks::Unit& u, bool forward) -> Real {
     if (u.manifold < 0) return sweepRows(rows, bodies, u.begin, u.end, forward, blocks);
     PgsBlocks::Manifold& m = blocks->manifolds[size_t(u.manifold)];
-    const PgsBlocks::Point* P = blocks->points.data() + m.point;
     VisitBodies V(m, bodies);
     Real d;
     if (forward) {
-      d = compactFriction(m, P, V, true);
+      d = compactFriction(m, V, true);
       d = std::max(d, compactBlock(*blocks, m, rows, bodies, V, true));
     } else {
       d = compactBlock(*blocks, m, rows, bodies, V, false);
-      d = std::max(d, compactFriction(m, P, V, false));
+      d = std::max(d, compactFriction(m, V, false));
     }
     V.store(m, bodies);
     return d;

@@ -71,6 +71,10 @@ struct PgsBlocks {
     Real rhs[3], e[3], invDiag[3], lambda[3];  ///< friction rows t1, t2, twist
     Real dRhs[3], sInv[6];   ///< Block::dRhs, Block::sInv[0]
     Real eN;                 ///< the normal rows' compliance (one per block)
+    /// Sums over the points, kept with their impulses (one pass when a block update is accepted, instead of
+    /// two loops per visit): sum lambda, sum lambda u, sum lambda v (the compliance's term of the block's
+    /// residual) and sum max(lambda, 0) (the friction bound, boundingNormal).
+    Real sl, slu, slv, sumN;
     Real mu, muTwist;        ///< friction coefficients of the pair and the twist (ConstraintRow::mu)
     int32_t a, b;            ///< solver bodies (-1: static)
     uint32_t row;            ///< ConstraintRow of t1; t2 = row + 1, twist = row + 2, normals from row + 3
