@@ -535,19 +535,23 @@ static Real sweepRows(std::vector<ConstraintRow>& rows, std::vector<SolverBodySt
 }
 
 // ---- issue 18 (compact contact arrays): compact manifold sweeps ----
-// DESIGN (docs/solver-internals.md "Compact manifold sweeps"): the serial sweeps visit a manifold contact
-// (contact_rows.h: [t1, t2, twist][normal block]) from one compact record, PgsBlocks::Manifold, and its points,
-// instead of seven 352-byte ConstraintRows and a Block: the friction rows' J and W and the block's operators as
-// 6-vectors [linear; angular] against the body's (v, w) read as one 6-vector, which SSE2 (the baseline x86-64
-// build) evaluates two doubles at a time, and the normal rows' block coordinates, compliances, impulses and
-// bounds in 48 bytes each. The law and the visiting order are those of solveUnit and solvePreparedBlock; the
-// sums run in another order, so impulses differ from the ConstraintRow path in the last bits. A block visit
-// that leaves a bound (tipping, separating) writes the manifold's normal impulses back, runs the ConstraintRow
-// path (solveClampedBlock, else row by row) and reads them again: rare, and one code path for the clamping. The
-// records are built at the start of PgsSolver::iterate (reused storage) and the impulses written back at its
-// end, so the result store keeps reading ConstraintRows; the shock pass solves a manifold support from the same
-// record (solveSupportCompact). PgsSolver::prepare clears the records, so a path that does not rebuild them
-// (the hybrid and coloured sweeps) never reads last step's.
+// DESIGN (docs/solver-internals.md "Compact manifold sweeps", "Compact contact rows"): the serial sweeps visit a
+// manifold contact (contact_rows.h: [t1, t2, twist][normal block]) from one compact record, PgsBlocks::Manifold
+// (928 bytes), and its 32-byte points, instead of seven 352-byte ConstraintRows and a Block. The record holds
+// what the contact layout makes necessary and no more: J_linB = -J_linA, so a row's linear part is one A-side
+// direction against v_A - v_B and its M^-1 J_lin^T that direction times the inverse mass (three directions serve
+// the six rows: the tilt coordinates and the twist have none); the angular parts J_ang and I^-1 J_ang^T of both
+// bodies as one 6-vector [A; B], dotted with (w_A; w_B) held as one 6-vector, which SSE2 (the baseline x86-64
+// build) evaluates two doubles at a time; the points' block coordinates, impulses and lower bounds (one
+// compliance per block, no upper bound). The law and the visiting order are those of solveUnit and
+// solvePreparedBlock; the sums run in another order, so impulses differ from the ConstraintRow path in the last
+// bits. A block visit that leaves a bound (tipping, separating) writes the manifold's normal impulses back, runs
+// the ConstraintRow path (solveClampedBlock, else row by row) and reads them again: rare, and one code path for
+// the clamping. The records are built at the start of PgsSolver::iterate (reused storage) and the impulses
+// written back at its end, so the result store keeps reading ConstraintRows; the shock pass solves a manifold
+// support from the same record (solveSupportCompact). A manifold whose rows do not have the contact layout
+// (fitsCompactLayout) keeps the ConstraintRow sweeps. PgsSolver::prepare clears the records, so a path that does
+// not rebuild them (the hybrid and coloured sweeps) never reads last step's.
 namespace {
 
 /// True when rows [i, i + 3 + n) are a manifold of the compact form (contact_rows.cpp builds them so).
@@ -1037,6 +1041,37 @@ bool PgsSolver::solveSupportExactly(std::vector<ConstraintRow>& rows, std::vecto
 // The support solve above on a compact manifold record (PgsSolver::iterate): the same system, its operators
 // read as 6-vectors, the impulses read from and written to the ConstraintRows (the shock pass's state).
 namespace {
+/// Solves K x = b for a symmetric positive definite 6 x 6 K (lower triangle read) by an unrolled Cholesky
+/// factorisation; false when a pivot is not positive (as Eigen::LLT reports). Written out because Eigen's
+/// general LLT was 0.39 M of pyramid20's 10.3 M instructions per step (one solve per shock support).
+bool choleskySolve6(const Real K[6][6], const Real b[6], Real x[6]) {
+  Real L[6][6], inv[6];
+  for (int j = 0; j < 6; ++j) {
+    Real d = K[j][j];
+    for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
+    if (!(d > 0)) return false;
+    const Real ljj = std::sqrt(d);
+    inv[j] = 1 / ljj;
+    for (int i = j + 1; i < 6; ++i) {
+      Real s = K[i][j];
+      for (int k = 0; k < j; ++k) s -= L[i][k] * L[j][k];
+      L[i][j] = s * inv[j];
+    }
+  }
+  Real y[6];
+  for (int i = 0; i < 6; ++i) {
+    Real s = b[i];
+    for (int k = 0; k < i; ++k) s -= L[i][k] * y[k];
+    y[i] = s * inv[i];
+  }
+  for (int i = 6; i-- > 0;) {
+    Real s = y[i];
+    for (int k = i + 1; k < 6; ++k) s -= L[k][i] * x[k];
+    x[i] = s * inv[i];
+  }
+  return std::isfinite(x[0] + x[1] + x[2] + x[3] + x[4] + x[5]);
+}
+
 bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                          const PgsSolver::ShockRange& sr, const PgsBlocks& pb, const PgsBlocks::Manifold& m) {
   constexpr int kM = 6;
@@ -1049,35 +1084,38 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   ConstraintRow* F = rows.data() + m.row;
   ConstraintRow* R = F + 3;
   // The six rows on the free body (rows 0..2 the block's coordinates, 3..5 the friction rows): G = [lin; ang],
-  // W = M^-1 G^T. The B side's linear part is the A side's negated (pgs.h PgsBlocks::Manifold).
-  const Real sign = freeA ? 1.0 : -1.0, im = freeA ? m.imA : m.imB;
+  // W = M^-1 G^T. Rows 0, 3 and 4 have a linear part (the B side's is the A side's negated, which the product
+  // G W^T does not see); the angular parts are the free side's half of the record's [A; B] 6-vectors.
+  const Real im = freeA ? m.imA : m.imB;
   const int side = freeA ? 0 : 3;
-  Vec3 gl[kM], ga[kM], wl[kM], wa[kM];
-  for (int k = 0; k < kM; ++k) {
-    const Vec3 l = k == 0 ? m.lin[0] : k == 3 ? m.lin[1] : k == 4 ? m.lin[2] : Vec3::Zero().eval();
-    gl[k] = sign * l;
-    wl[k] = (sign * im) * l;
-    ga[k] = m.ang[k].segment<3>(side);
-    wa[k] = m.w[k].segment<3>(side);
-  }
-  Eigen::Matrix<Real, kM, kM> K;
-  for (int a = 0; a < kM; ++a)
-    for (int c = 0; c <= a; ++c) K(a, c) = K(c, a) = gl[a].dot(wl[c]) + ga[a].dot(wa[c]);
-  // Regularisation: the block's D E D^T (one compliance per block), the friction rows' own e.
-  Real dE[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-  Real b[kM];
-  for (int a = 0; a < 3; ++a) b[a] = m.dRhs[a];
-  for (int i = 0; i < n; ++i) {
-    const Real D[3] = {1.0, P[i].u, P[i].v};
-    const Real e = m.eN, el = e * R[i].lambda;
-    for (int a = 0; a < 3; ++a) {
-      b[a] -= D[a] * el;
-      for (int c = 0; c < 3; ++c) dE[a][c] += D[a] * e * D[c];
+  constexpr int kLinRow[3] = {0, 3, 4};
+  Real K[kM][kM];
+  for (int a = 0; a < kM; ++a) {
+    const Real* ga = m.ang[a].data() + side;
+    for (int c = 0; c <= a; ++c) {
+      const Real* wc = m.w[c].data() + side;
+      K[a][c] = ga[0] * wc[0] + ga[1] * wc[1] + ga[2] * wc[2];
     }
   }
-  for (int a = 0; a < 3; ++a)
-    for (int c = 0; c < 3; ++c) K(a, c) += dE[a][c];
-  for (int k = 0; k < 3; ++k) K(3 + k, 3 + k) += m.e[k];
+  for (int p = 0; p < 3; ++p)
+    for (int q = 0; q <= p; ++q) K[kLinRow[p]][kLinRow[q]] += im * m.lin[p].dot(m.lin[q]);
+  // Regularisation: the block's D E D^T (one compliance per block), the friction rows' own e.
+  Real b[kM];
+  for (int a = 0; a < 3; ++a) b[a] = m.dRhs[a];
+  {
+    Real dE[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (int i = 0; i < n; ++i) {
+      const Real D[3] = {1.0, P[i].u, P[i].v};
+      const Real el = m.eN * R[i].lambda;
+      for (int a = 0; a < 3; ++a) {
+        b[a] -= D[a] * el;
+        for (int c = 0; c <= a; ++c) dE[a][c] += D[a] * D[c];
+      }
+    }
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c <= a; ++c) K[a][c] += m.eN * dE[a][c];
+  }
+  for (int k = 0; k < 3; ++k) K[3 + k][3 + k] += m.e[k];
   // Residuals (velocities of both bodies, as in the sweeps).
   const VisitBodies V(m, bodies);
   b[0] -= V.rowVelocity(m.lin[0], m.ang[0]);
@@ -1090,15 +1128,12 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   // A degenerate axis carries nothing (as in the block).
   for (int a = 1; a < 3; ++a)
     if (!(a == 1 ? m.axisU : m.axisV)) {
-      K.row(a).setZero();
-      K.col(a).setZero();
-      K(a, a) = 1;
+      for (int c = 0; c < kM; ++c) K[a][c] = K[c][a] = 0;
+      K[a][a] = 1;
       b[a] = 0;
     }
-  const Eigen::LLT<Eigen::Matrix<Real, kM, kM>> llt(K);
-  if (llt.info() != Eigen::Success) return false;
-  const Eigen::Matrix<Real, kM, 1> x = llt.solve(Eigen::Map<const Eigen::Matrix<Real, kM, 1>>(b));
-  if (!x.allFinite()) return false;
+  Real x[kM];
+  if (!choleskySolve6(K, b, x)) return false;
   // Bounds: the new normal impulses, then the friction inside mu times their new sum.
   Real nl[kMaxNormalBlock];
   Real sumN = 0;
@@ -1118,13 +1153,11 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   if (std::abs(fl[2]) > frictionLimit(m.muTwist, sumN)) return false;
   for (int i = 0; i < n; ++i) R[i].lambda = nl[i];
   for (int k = 0; k < 3; ++k) F[k].lambda = fl[k];
-  Vec3 dv = Vec3::Zero(), dw = Vec3::Zero();
-  for (int a = 0; a < kM; ++a) {
-    dv += wl[a] * x[a];
-    dw += wa[a] * x[a];
-  }
-  bodies[size_t(fb)].v += dv;
-  bodies[size_t(fb)].w += dw;
+  Vec6 dw = Vec6::Zero();
+  for (int a = 0; a < kM; ++a) dw += m.w[a] * x[a];
+  const Vec3 dl = m.lin[0] * x[0] + m.lin[1] * x[3] + m.lin[2] * x[4];
+  bodies[size_t(fb)].v += (freeA ? im : -im) * dl;
+  bodies[size_t(fb)].w += dw.segment<3>(side);
   return true;
 }
 
