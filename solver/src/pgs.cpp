@@ -537,13 +537,13 @@ static Real sweepRows(std::vector<ConstraintRow>& rows, std::vector<SolverBodySt
 // ---- issue 18 (compact contact arrays): compact manifold sweeps ----
 // DESIGN (docs/solver-internals.md "Compact manifold sweeps", "Compact contact rows"): the serial sweeps visit a
 // manifold contact (contact_rows.h: [t1, t2, twist][normal block]) from one compact record, PgsBlocks::Manifold
-// (928 bytes), and its 32-byte points, instead of seven 352-byte ConstraintRows and a Block. The record holds
+// (928 bytes), and its 40-byte points, instead of seven 352-byte ConstraintRows and a Block. The record holds
 // what the contact layout makes necessary and no more: J_linB = -J_linA, so a row's linear part is one A-side
 // direction against v_A - v_B and its M^-1 J_lin^T that direction times the inverse mass (three directions serve
 // the six rows: the tilt coordinates and the twist have none); the angular parts J_ang and I^-1 J_ang^T of both
 // bodies as one 6-vector [A; B], dotted with (w_A; w_B) held as one 6-vector, which SSE2 (the baseline x86-64
-// build) evaluates two doubles at a time; the points' block coordinates, impulses and lower bounds (one
-// compliance per block, no upper bound). The law and the visiting order are those of solveUnit and
+// build) evaluates two doubles at a time; the points' block coordinates, compliances, impulses and lower bounds
+// (no upper bound). The law and the visiting order are those of solveUnit and
 // solvePreparedBlock; the sums run in another order, so impulses differ from the ConstraintRow path in the last
 // bits. A block visit that leaves a bound (tipping, separating) writes the manifold's normal impulses back, runs
 // the ConstraintRow path (solveClampedBlock, else row by row) and reads them again: rare, and one code path for
@@ -588,7 +588,7 @@ size_t unitSpan(const std::vector<ConstraintRow>& rows, size_t i) {
 
 /// The compact layout's extra conditions (pgs.h PgsBlocks::Manifold) on a manifold of the compact form:
 /// J_linB = -J_linA on the tangent rows and the block centre, no linear part on the twist row nor (to 1e-12 of
-/// the centre's) on the tilt coordinates, one compliance and no upper bound on the normal rows. contact_rows.cpp
+/// the centre's) on the tilt coordinates, no upper bound on the normal rows. contact_rows.cpp
 /// builds its manifolds so; anything else keeps the ConstraintRow sweeps.
 bool fitsCompactLayout(const std::vector<ConstraintRow>& rows, size_t i, int n, const PgsBlocks::Block& B) {
   for (size_t k = 0; k < 2; ++k)
@@ -598,11 +598,8 @@ bool fitsCompactLayout(const std::vector<ConstraintRow>& rows, size_t i, int n, 
   const Real tol = 1e-12 * B.gLinA[0].norm();
   for (int a = 1; a < 3; ++a)
     if (B.gLinA[a].norm() > tol || B.gLinB[a].norm() > tol) return false;
-  const Real e = rows[i + 3].e;
-  for (int k = 0; k < n; ++k) {
-    const ConstraintRow& r = rows[i + 3 + size_t(k)];
-    if (r.e != e || r.hi < 1e300) return false;
-  }
+  for (int k = 0; k < n; ++k)
+    if (rows[i + 3 + size_t(k)].hi < 1e300) return false;
   return true;
 }
 
@@ -610,10 +607,10 @@ bool fitsCompactLayout(const std::vector<ConstraintRow>& rows, size_t i, int n, 
 void updateSums(PgsBlocks::Manifold& m, const PgsBlocks::Point* P) {
   Real sl = 0, slu = 0, slv = 0, pos = 0;
   for (int i = 0; i < m.n; ++i) {
-    const Real l = P[i].lambda;
-    sl += l;
-    slu += l * P[i].u;
-    slv += l * P[i].v;
+    const Real l = P[i].lambda, el = P[i].e * l;
+    sl += el;
+    slu += el * P[i].u;
+    slv += el * P[i].v;
     pos += std::max<Real>(l, 0);
   }
   m.sl = sl;
@@ -671,10 +668,9 @@ void buildCompact(const std::vector<ConstraintRow>& rows, const std::vector<Solv
     m.ok = B.ok[0];
     m.axisU = B.axisU;
     m.axisV = B.axisV;
-    m.eN = rows[i + 3].e;
     for (int k = 0; k < n; ++k) {
       const ConstraintRow& r = rows[i + 3 + size_t(k)];
-      pb.points.push_back({r.blockU, r.blockV, r.lambda, r.lo});
+      pb.points.push_back({r.blockU, r.blockV, r.e, r.lambda, r.lo});
     }
     updateSums(m, pb.points.data() + m.point);
     pb.plan.push_back({uint32_t(i), uint32_t(i) + 3 + uint32_t(n), int32_t(pb.manifolds.size() - 1)});
@@ -798,12 +794,11 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
   PgsBlocks::Point* P = pb.points.data() + m.point;
   const int n = m.n;
   if (m.ok) {
-    // The points' compliance is one per block: the sums of lambda, lambda u and lambda v (kept with the
-    // impulses) carry its term.
+    // The compliances' term: the sums of e lambda, e lambda u and e lambda v, kept with the impulses.
     Real b[3];
-    b[0] = m.dRhs[0] - V.rowVelocity(m.lin[0], m.ang[0]) - m.eN * m.sl;
-    b[1] = m.axisU ? m.dRhs[1] - m.ang[1].dot(V.w) - m.eN * m.slu : 0.0;
-    b[2] = m.axisV ? m.dRhs[2] - m.ang[2].dot(V.w) - m.eN * m.slv : 0.0;
+    b[0] = m.dRhs[0] - V.rowVelocity(m.lin[0], m.ang[0]) - m.sl;
+    b[1] = m.axisU ? m.dRhs[1] - m.ang[1].dot(V.w) - m.slu : 0.0;
+    b[2] = m.axisV ? m.dRhs[2] - m.ang[2].dot(V.w) - m.slv : 0.0;
     const Real* Si = m.sInv;
     Real dmu[3];
     dmu[0] = Si[0] * b[0] + Si[1] * b[1] + Si[3] * b[2];
@@ -819,11 +814,11 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
       if (inside) {
         Real maxD = 0, sl = 0, slu = 0, slv = 0, pos = 0;
         for (int i = 0; i < n; ++i) {
-          const Real l = P[i].lambda += dl[i];
+          const Real l = P[i].lambda += dl[i], el = P[i].e * l;
           maxD = std::max(maxD, std::abs(dl[i]));
-          sl += l;
-          slu += l * P[i].u;
-          slv += l * P[i].v;
+          sl += el;
+          slu += el * P[i].u;
+          slv += el * P[i].v;
           pos += std::max<Real>(l, 0);
         }
         m.sl = sl;
@@ -1099,21 +1094,16 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   }
   for (int p = 0; p < 3; ++p)
     for (int q = 0; q <= p; ++q) K[kLinRow[p]][kLinRow[q]] += im * m.lin[p].dot(m.lin[q]);
-  // Regularisation: the block's D E D^T (one compliance per block), the friction rows' own e.
+  // Regularisation: the block's D E D^T, the friction rows' own e.
   Real b[kM];
   for (int a = 0; a < 3; ++a) b[a] = m.dRhs[a];
-  {
-    Real dE[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-    for (int i = 0; i < n; ++i) {
-      const Real D[3] = {1.0, P[i].u, P[i].v};
-      const Real el = m.eN * R[i].lambda;
-      for (int a = 0; a < 3; ++a) {
-        b[a] -= D[a] * el;
-        for (int c = 0; c <= a; ++c) dE[a][c] += D[a] * D[c];
-      }
+  for (int i = 0; i < n; ++i) {
+    const Real D[3] = {1.0, P[i].u, P[i].v};
+    const Real e = P[i].e, el = e * R[i].lambda;
+    for (int a = 0; a < 3; ++a) {
+      b[a] -= D[a] * el;
+      for (int c = 0; c <= a; ++c) K[a][c] += D[a] * e * D[c];
     }
-    for (int a = 0; a < 3; ++a)
-      for (int c = 0; c <= a; ++c) K[a][c] += m.eN * dE[a][c];
   }
   for (int k = 0; k < 3; ++k) K[3 + k][3 + k] += m.e[k];
   // Residuals (velocities of both bodies, as in the sweeps).

@@ -58,8 +58,9 @@ struct PgsBlocks {
   ///    t2) serve all six rows;
   ///  - per row only the angular parts J_ang and I^-1 J_ang^T, both bodies' as one 6-vector [A; B] that a visit
   ///    dots with the bodies' angular velocities (w_A; w_B) held as one 6-vector (SSE2: three packets of two);
-  ///  - per point its block coordinates, impulse and lower bound (32 bytes): the compliance is one per manifold
-  ///    (the block exists only for points of one contact law) and the upper bound is unbounded.
+  ///  - per point its block coordinates, compliance, impulse and lower bound (40 bytes; contact normal rows
+  ///    have no upper bound). The compliance stays per point: a tilted manifold mixes touching points (SPOOK's
+  ///    e) with speculative ones (e = 0).
   /// Double precision throughout: the compact sweeps must give the ConstraintRow sweeps' impulses to 1e-9
   /// (test_unit_compact_sweeps), which float Jacobians (6e-8 relative) do not.
   using Vec6 = Eigen::Matrix<Real, 6, 1>;
@@ -70,9 +71,8 @@ struct PgsBlocks {
     Real imA, imB;           ///< the bodies' inverse masses (0: static)
     Real rhs[3], e[3], invDiag[3], lambda[3];  ///< friction rows t1, t2, twist
     Real dRhs[3], sInv[6];   ///< Block::dRhs, Block::sInv[0]
-    Real eN;                 ///< the normal rows' compliance (one per block)
     /// Sums over the points, kept with their impulses (one pass when a block update is accepted, instead of
-    /// two loops per visit): sum lambda, sum lambda u, sum lambda v (the compliance's term of the block's
+    /// two loops per visit): sum e lambda, sum e lambda u, sum e lambda v (the compliances' term of the block's
     /// residual) and sum max(lambda, 0) (the friction bound, boundingNormal).
     Real sl, slu, slv, sumN;
     Real mu, muTwist;        ///< friction coefficients of the pair and the twist (ConstraintRow::mu)
@@ -84,9 +84,9 @@ struct PgsBlocks {
     bool cone;               ///< t1, t2 a projected-cone pair (else two scaled-box rows)
     bool ok, axisU, axisV;   ///< Block::ok[0], axisU, axisV
   };
-  /// A normal row of a manifold block: its block coordinates, impulse and lower bound.
+  /// A normal row of a manifold block: its block coordinates, compliance, impulse and lower bound.
   struct Point {
-    Real u, v, lambda, lo;
+    Real u, v, e, lambda, lo;
   };
   /// The serial sweep's visiting order: a compact manifold (manifold >= 0) or the ConstraintRows [begin, end)
   /// swept row by row (joints, per-point contacts, anything not of the manifold form).
