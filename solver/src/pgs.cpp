@@ -200,14 +200,18 @@ static void buildBlock(const ConstraintRow* R, const std::vector<SolverBodyState
   }
   // S = D (K + E) D^T = G_a . W_c (over the free bodies) + sum_i D_ai e_i D_ci: the parts of body A, of body B
   // and of E once (symmetric), then summed per configuration.
-  Real SA[3][3], SB[3][3], SE[3][3];
+  Real SA[3][3], SB[3][3], SE[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  // E's part in one pass over the points (each entry summed in the points' order, as before).
+  for (int i = 0; i < n; ++i) {
+    const Real D[3] = {1.0, R[i].blockU, R[i].blockV};
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c <= a; ++c) SE[a][c] += D[a] * R[i].e * D[c];
+  }
   for (int a = 0; a < 3; ++a)
     for (int c = 0; c <= a; ++c) {
       SA[a][c] = SA[c][a] = hasA ? B.gLinA[a].dot(B.wLinA[c]) + B.gAngA[a].dot(B.wAngA[c]) : 0.0;
       SB[a][c] = SB[c][a] = hasB ? B.gLinB[a].dot(B.wLinB[c]) + B.gAngB[a].dot(B.wAngB[c]) : 0.0;
-      Real e = 0;
-      for (int i = 0; i < n; ++i) e += blockD(R[i], a) * R[i].e * blockD(R[i], c);
-      SE[a][c] = SE[c][a] = e;
+      SE[c][a] = SE[a][c];
     }
   for (int cfg = 0; cfg < 3; ++cfg) {
     const bool useA = cfg != 1, useB = cfg != 2;
@@ -531,19 +535,23 @@ static Real sweepRows(std::vector<ConstraintRow>& rows, std::vector<SolverBodySt
 }
 
 // ---- issue 18 (compact contact arrays): compact manifold sweeps ----
-// DESIGN (docs/solver-internals.md "Compact manifold sweeps"): the serial sweeps visit a manifold contact
-// (contact_rows.h: [t1, t2, twist][normal block]) from one compact record, PgsBlocks::Manifold, and its points,
-// instead of seven 352-byte ConstraintRows and a Block: the friction rows' J and W and the block's operators as
-// 6-vectors [linear; angular] against the body's (v, w) read as one 6-vector, which SSE2 (the baseline x86-64
-// build) evaluates two doubles at a time, and the normal rows' block coordinates, compliances, impulses and
-// bounds in 48 bytes each. The law and the visiting order are those of solveUnit and solvePreparedBlock; the
-// sums run in another order, so impulses differ from the ConstraintRow path in the last bits. A block visit
-// that leaves a bound (tipping, separating) writes the manifold's normal impulses back, runs the ConstraintRow
-// path (solveClampedBlock, else row by row) and reads them again: rare, and one code path for the clamping. The
-// records are built at the start of PgsSolver::iterate (reused storage) and the impulses written back at its
-// end, so the result store keeps reading ConstraintRows; the shock pass solves a manifold support from the same
-// record (solveSupportCompact). PgsSolver::prepare clears the records, so a path that does not rebuild them
-// (the hybrid and coloured sweeps) never reads last step's.
+// DESIGN (docs/solver-internals.md "Compact manifold sweeps", "Compact contact rows"): the serial sweeps visit a
+// manifold contact (contact_rows.h: [t1, t2, twist][normal block]) from one compact record, PgsBlocks::Manifold
+// (928 bytes), and its 40-byte points, instead of seven 352-byte ConstraintRows and a Block. The record holds
+// what the contact layout makes necessary and no more: J_linB = -J_linA, so a row's linear part is one A-side
+// direction against v_A - v_B and its M^-1 J_lin^T that direction times the inverse mass (three directions serve
+// the six rows: the tilt coordinates and the twist have none); the angular parts J_ang and I^-1 J_ang^T of both
+// bodies as one 6-vector [A; B], dotted with (w_A; w_B) held as one 6-vector, which SSE2 (the baseline x86-64
+// build) evaluates two doubles at a time; the points' block coordinates, compliances, impulses and lower bounds
+// (no upper bound). The law and the visiting order are those of solveUnit and
+// solvePreparedBlock; the sums run in another order, so impulses differ from the ConstraintRow path in the last
+// bits. A block visit that leaves a bound (tipping, separating) writes the manifold's normal impulses back, runs
+// the ConstraintRow path (solveClampedBlock, else row by row) and reads them again: rare, and one code path for
+// the clamping. The records are built at the start of PgsSolver::iterate (reused storage) and the impulses
+// written back at its end, so the result store keeps reading ConstraintRows; the shock pass solves a manifold
+// support from the same record (solveSupportCompact). A manifold whose rows do not have the contact layout
+// (fitsCompactLayout) keeps the ConstraintRow sweeps. PgsSolver::prepare clears the records, so a path that does
+// not rebuild them (the hybrid and coloured sweeps) never reads last step's.
 namespace {
 
 /// True when rows [i, i + 3 + n) are a manifold of the compact form (contact_rows.cpp builds them so).
@@ -578,22 +586,59 @@ size_t unitSpan(const std::vector<ConstraintRow>& rows, size_t i) {
   return 1;
 }
 
-void buildCompact(const std::vector<ConstraintRow>& rows, PgsBlocks& pb) {
+/// The compact layout's extra conditions (pgs.h PgsBlocks::Manifold) on a manifold of the compact form:
+/// J_linB = -J_linA on the tangent rows and the block centre, no linear part on the twist row nor (to 1e-12 of
+/// the centre's) on the tilt coordinates, no upper bound on the normal rows. contact_rows.cpp
+/// builds its manifolds so; anything else keeps the ConstraintRow sweeps.
+bool fitsCompactLayout(const std::vector<ConstraintRow>& rows, size_t i, int n, const PgsBlocks::Block& B) {
+  for (size_t k = 0; k < 2; ++k)
+    if (rows[i + k].jLinB != -rows[i + k].jLinA) return false;
+  if (!rows[i + 2].jLinA.isZero(0) || !rows[i + 2].jLinB.isZero(0)) return false;
+  if (B.gLinB[0] != -B.gLinA[0]) return false;
+  const Real tol = 1e-12 * B.gLinA[0].norm();
+  for (int a = 1; a < 3; ++a)
+    if (B.gLinA[a].norm() > tol || B.gLinB[a].norm() > tol) return false;
+  for (int k = 0; k < n; ++k)
+    if (rows[i + 3 + size_t(k)].hi < 1e300) return false;
+  return true;
+}
+
+/// The manifold's sums over its points' normal impulses (PgsBlocks::Manifold::sl), from the points.
+void updateSums(PgsBlocks::Manifold& m, const PgsBlocks::Point* P) {
+  Real sl = 0, slu = 0, slv = 0, pos = 0;
+  for (int i = 0; i < m.n; ++i) {
+    const Real l = P[i].lambda, el = P[i].e * l;
+    sl += el;
+    slu += el * P[i].u;
+    slv += el * P[i].v;
+    pos += std::max<Real>(l, 0);
+  }
+  m.sl = sl;
+  m.slu = slu;
+  m.slv = slv;
+  m.sumN = pos;
+}
+
+void buildCompact(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                  PgsBlocks& pb) {
   pb.manifolds.clear();
   pb.points.clear();
   pb.plan.clear();
   size_t runBegin = 0;
   for (size_t i = 0; i < rows.size();) {
     int n = 0;
-    if (!isCompactManifold(rows, i, n)) {
+    if (!isCompactManifold(rows, i, n) ||
+        !fitsCompactLayout(rows, i, n, pb.blocks[size_t(rows[i + 3].blockSlot)])) {
       i += unitSpan(rows, i);
       continue;
     }
     if (runBegin < i) pb.plan.push_back({uint32_t(runBegin), uint32_t(i), -1});
-    PgsBlocks::Manifold m;
+    PgsBlocks::Manifold& m = pb.manifolds.emplace_back();
     const ConstraintRow& t1 = rows[i];
     m.a = t1.bodyA;
     m.b = t1.bodyB;
+    m.imA = m.a >= 0 ? bodies[size_t(m.a)].invMass : 0.0;
+    m.imB = m.b >= 0 ? bodies[size_t(m.b)].invMass : 0.0;
     m.row = uint32_t(i);
     m.block = uint32_t(rows[i + 3].blockSlot);
     m.point = uint32_t(pb.points.size());
@@ -603,22 +648,20 @@ void buildCompact(const std::vector<ConstraintRow>& rows, PgsBlocks& pb) {
     m.muTwist = rows[i + 2].mu;
     for (int k = 0; k < 3; ++k) {
       const ConstraintRow& r = rows[i + size_t(k)];
-      PgsBlocks::FrictionRow& f = m.f[k];
-      f.jA << r.jLinA, r.jAngA;
-      f.jB << r.jLinB, r.jAngB;
-      f.wA << r.mJLinA, r.mJAngA;
-      f.wB << r.mJLinB, r.mJAngB;
-      f.rhs = r.rhs;
-      f.e = r.e;
-      f.invDiag = r.invDiag;
-      f.lambda = r.lambda;
+      m.ang[3 + k] << r.jAngA, r.jAngB;
+      m.w[3 + k] << r.mJAngA, r.mJAngB;
+      m.rhs[k] = r.rhs;
+      m.e[k] = r.e;
+      m.invDiag[k] = r.invDiag;
+      m.lambda[k] = r.lambda;
     }
+    m.lin[1] = rows[i].jLinA;
+    m.lin[2] = rows[i + 1].jLinA;
     const PgsBlocks::Block& B = pb.blocks[m.block];
+    m.lin[0] = B.gLinA[0];
     for (int a = 0; a < 3; ++a) {
-      m.gA[a] << B.gLinA[a], B.gAngA[a];
-      m.gB[a] << B.gLinB[a], B.gAngB[a];
-      m.wA[a] << B.wLinA[a], B.wAngA[a];
-      m.wB[a] << B.wLinB[a], B.wAngB[a];
+      m.ang[a] << B.gAngA[a], B.gAngB[a];
+      m.w[a] << B.wAngA[a], B.wAngB[a];
       m.dRhs[a] = B.dRhs[a];
     }
     for (int k = 0; k < 6; ++k) m.sInv[k] = B.sInv[0][k];
@@ -627,10 +670,10 @@ void buildCompact(const std::vector<ConstraintRow>& rows, PgsBlocks& pb) {
     m.axisV = B.axisV;
     for (int k = 0; k < n; ++k) {
       const ConstraintRow& r = rows[i + 3 + size_t(k)];
-      pb.points.push_back({r.blockU, r.blockV, r.e, r.lambda, r.lo, r.hi});
+      pb.points.push_back({r.blockU, r.blockV, r.e, r.lambda, r.lo});
     }
-    pb.plan.push_back({uint32_t(i), uint32_t(i) + 3 + uint32_t(n), int32_t(pb.manifolds.size())});
-    pb.manifolds.push_back(m);
+    updateSums(m, pb.points.data() + m.point);
+    pb.plan.push_back({uint32_t(i), uint32_t(i) + 3 + uint32_t(n), int32_t(pb.manifolds.size() - 1)});
     i += 3 + size_t(n);
     runBegin = i;
   }
@@ -639,74 +682,90 @@ void buildCompact(const std::vector<ConstraintRow>& rows, PgsBlocks& pb) {
 
 void writeBackCompact(std::vector<ConstraintRow>& rows, const PgsBlocks& pb) {
   for (const PgsBlocks::Manifold& m : pb.manifolds) {
-    for (int k = 0; k < 3; ++k) rows[m.row + uint32_t(k)].lambda = m.f[k].lambda;
+    for (int k = 0; k < 3; ++k) rows[m.row + uint32_t(k)].lambda = m.lambda[k];
     for (int k = 0; k < m.n; ++k) rows[m.row + 3 + uint32_t(k)].lambda = pb.points[m.point + uint32_t(k)].lambda;
   }
 }
 
-// A solver body's (v, w) as one Vec6 (SolverBodyState keeps w right after v).
-static_assert(offsetof(SolverBodyState, w) == 3 * sizeof(Real));
 using Vec6 = PgsBlocks::Vec6;
-inline Eigen::Map<Vec6> velocity(std::vector<SolverBodyState>& b, int32_t i) {
-  return Eigen::Map<Vec6>(b[size_t(i)].v.data());
-}
-inline Eigen::Map<const Vec6> velocity(const std::vector<SolverBodyState>& b, int32_t i) {
-  return Eigen::Map<const Vec6>(b[size_t(i)].v.data());
-}
 
-/// The friction rows' bound: mu times the sum of the manifold's positive normal impulses (boundingNormal).
-inline Real compactNormalSum(const PgsBlocks::Point* P, int n) {
-  Real sum = 0;
-  for (int k = 0; k < n; ++k) sum += std::max<Real>(P[k].lambda, 0);
-  return sum;
-}
 
 /// The two bodies' velocities during one manifold visit. Every row of a manifold acts on the same two bodies, so
-/// a visit reads their (v, w) once into registers and stores them once; a static side reads as zero and is never
-/// stored (its W is zero, so the rows leave its local copy at zero).
+/// a visit reads their velocities once into registers and stores them once: the linear ones apart (the rows'
+/// linear parts act on v_A - v_B), the angular ones as one 6-vector (w_A; w_B) against the rows' [A; B] angular
+/// parts. A static side reads as zero and is never stored (its inverse mass and I^-1 J are zero, so the rows
+/// leave its local copy at zero).
 struct VisitBodies {
-  Vec6 a, b;
+  Vec3 vA, vB;
+  Vec6 w;
   bool hasA, hasB;
   VisitBodies(const PgsBlocks::Manifold& m, const std::vector<SolverBodyState>& bodies)
       : hasA(m.a >= 0), hasB(m.b >= 0) {
-    a = hasA ? Vec6(velocity(bodies, m.a)) : Vec6::Zero();
-    b = hasB ? Vec6(velocity(bodies, m.b)) : Vec6::Zero();
+    if (hasA) {
+      vA = bodies[size_t(m.a)].v;
+      w.head<3>() = bodies[size_t(m.a)].w;
+    } else {
+      vA.setZero();
+      w.head<3>().setZero();
+    }
+    if (hasB) {
+      vB = bodies[size_t(m.b)].v;
+      w.tail<3>() = bodies[size_t(m.b)].w;
+    } else {
+      vB.setZero();
+      w.tail<3>().setZero();
+    }
   }
   void store(const PgsBlocks::Manifold& m, std::vector<SolverBodyState>& bodies) const {
-    if (hasA) velocity(bodies, m.a) = a;
-    if (hasB) velocity(bodies, m.b) = b;
+    if (hasA) {
+      bodies[size_t(m.a)].v = vA;
+      bodies[size_t(m.a)].w = w.head<3>();
+    }
+    if (hasB) {
+      bodies[size_t(m.b)].v = vB;
+      bodies[size_t(m.b)].w = w.tail<3>();
+    }
+  }
+  /// J v of a row with A-side linear part l and angular part [A; B] ang.
+  Real rowVelocity(const Vec3& l, const Vec6& ang) const { return l.dot(vA - vB) + ang.dot(w); }
+  /// The linear velocity change of an impulse d along the A-side direction l.
+  void push(const PgsBlocks::Manifold& m, const Vec3& l, Real d) {
+    vA += (m.imA * d) * l;
+    vB -= (m.imB * d) * l;
   }
 };
 
 /// The friction rows of a compact manifold, forward (t1/t2, twist) or backward (twist, t2/t1); solveUnit's law.
-Real compactFriction(PgsBlocks::Manifold& m, const PgsBlocks::Point* P, VisitBodies& V, bool forward) {
+Real compactFriction(PgsBlocks::Manifold& m, VisitBodies& V, bool forward) {
   Real maxDelta = 0;
-  // The normal impulses do not change during the friction rows' visit: their sum is formed once.
-  const Real sumN = compactNormalSum(P, m.n);
+  // The bound's sum of positive normal impulses, kept with the impulses (boundingNormal's sum).
+  const Real sumN = m.sumN;
+  // Row k (0 t1, 1 t2, 2 twist: no linear part).
+  auto velocity = [&](int k) {
+    return k < 2 ? V.rowVelocity(m.lin[1 + k], m.ang[3 + k]) : m.ang[5].dot(V.w);
+  };
   auto scalar = [&](int k, Real mu) {
-    PgsBlocks::FrictionRow& f = m.f[k];
     const Real lim = frictionLimit(mu, sumN);
-    const Real delta = (f.rhs - (f.jA.dot(V.a) + f.jB.dot(V.b)) - f.e * f.lambda) * f.invDiag;
-    const Real nl = std::clamp(f.lambda + delta, -lim, lim);
-    const Real d = nl - f.lambda;
-    f.lambda = nl;
-    V.a += f.wA * d;
-    V.b += f.wB * d;
+    const Real delta = (m.rhs[k] - velocity(k) - m.e[k] * m.lambda[k]) * m.invDiag[k];
+    const Real nl = std::clamp(m.lambda[k] + delta, -lim, lim);
+    const Real d = nl - m.lambda[k];
+    m.lambda[k] = nl;
+    V.w += m.w[3 + k] * d;
+    if (k < 2) V.push(m, m.lin[1 + k], d);
     maxDelta = std::max(maxDelta, std::abs(d));
   };
   auto pair = [&]() {
-    PgsBlocks::FrictionRow& r = m.f[0];
-    PgsBlocks::FrictionRow& s = m.f[1];
-    Real d1 = (r.rhs - (r.jA.dot(V.a) + r.jB.dot(V.b)) - r.e * r.lambda) * r.invDiag;
-    Real d2 = (s.rhs - (s.jA.dot(V.a) + s.jB.dot(V.b)) - s.e * s.lambda) * s.invDiag;
-    Real l1 = r.lambda + d1, l2 = s.lambda + d2;
+    Real d1 = (m.rhs[0] - velocity(0) - m.e[0] * m.lambda[0]) * m.invDiag[0];
+    Real d2 = (m.rhs[1] - velocity(1) - m.e[1] * m.lambda[1]) * m.invDiag[1];
+    Real l1 = m.lambda[0] + d1, l2 = m.lambda[1] + d2;
     projectOntoDisc(l1, l2, frictionLimit(m.mu, sumN));
-    d1 = l1 - r.lambda;
-    d2 = l2 - s.lambda;
-    r.lambda = l1;
-    s.lambda = l2;
-    V.a += r.wA * d1 + s.wA * d2;
-    V.b += r.wB * d1 + s.wB * d2;
+    d1 = l1 - m.lambda[0];
+    d2 = l2 - m.lambda[1];
+    m.lambda[0] = l1;
+    m.lambda[1] = l2;
+    V.w += m.w[3] * d1 + m.w[4] * d2;
+    const Vec3 dl = m.lin[1] * d1 + m.lin[2] * d2;
+    V.push(m, dl, 1.0);
     maxDelta = std::max(maxDelta, std::max(std::abs(d1), std::abs(d2)));
   };
   if (forward) {
@@ -735,16 +794,11 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
   PgsBlocks::Point* P = pb.points.data() + m.point;
   const int n = m.n;
   if (m.ok) {
+    // The compliances' term: the sums of e lambda, e lambda u and e lambda v, kept with the impulses.
     Real b[3];
-    for (int a = 0; a < 3; ++a) b[a] = m.dRhs[a] - (m.gA[a].dot(V.a) + m.gB[a].dot(V.b));
-    for (int i = 0; i < n; ++i) {
-      const Real el = P[i].e * P[i].lambda;
-      b[0] -= el;
-      b[1] -= el * P[i].u;
-      b[2] -= el * P[i].v;
-    }
-    if (!m.axisU) b[1] = 0;
-    if (!m.axisV) b[2] = 0;
+    b[0] = m.dRhs[0] - V.rowVelocity(m.lin[0], m.ang[0]) - m.sl;
+    b[1] = m.axisU ? m.dRhs[1] - m.ang[1].dot(V.w) - m.slu : 0.0;
+    b[2] = m.axisV ? m.dRhs[2] - m.ang[2].dot(V.w) - m.slv : 0.0;
     const Real* Si = m.sInv;
     Real dmu[3];
     dmu[0] = Si[0] * b[0] + Si[1] * b[1] + Si[3] * b[2];
@@ -755,17 +809,24 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
       bool inside = true;
       for (int i = 0; i < n; ++i) {
         dl[i] = dmu[0] + dmu[1] * P[i].u + dmu[2] * P[i].v;
-        const Real nl = P[i].lambda + dl[i];
-        inside &= nl >= P[i].lo && nl <= P[i].hi;
+        inside &= P[i].lambda + dl[i] >= P[i].lo;
       }
       if (inside) {
-        Real maxD = 0;
+        Real maxD = 0, sl = 0, slu = 0, slv = 0, pos = 0;
         for (int i = 0; i < n; ++i) {
-          P[i].lambda += dl[i];
+          const Real l = P[i].lambda += dl[i], el = P[i].e * l;
           maxD = std::max(maxD, std::abs(dl[i]));
+          sl += el;
+          slu += el * P[i].u;
+          slv += el * P[i].v;
+          pos += std::max<Real>(l, 0);
         }
-        V.a += m.wA[0] * dmu[0] + m.wA[1] * dmu[1] + m.wA[2] * dmu[2];
-        V.b += m.wB[0] * dmu[0] + m.wB[1] * dmu[1] + m.wB[2] * dmu[2];
+        m.sl = sl;
+        m.slu = slu;
+        m.slv = slv;
+        m.sumN = pos;
+        V.w += m.w[0] * dmu[0] + m.w[1] * dmu[1] + m.w[2] * dmu[2];
+        V.push(m, m.lin[0], dmu[0]);
         return maxD;
       }
     }
@@ -784,6 +845,7 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
     for (size_t k = first + size_t(n); k-- > first;) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
   }
   for (int i = 0; i < n; ++i) P[i].lambda = rows[first + size_t(i)].lambda;
+  updateSums(m, P);
   V = VisitBodies(m, bodies);
   return maxDelta;
 }
@@ -799,20 +861,19 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     for (int it = 0; it < iterations; ++it) maxDelta = sweepRows(rows, bodies, 0, rows.size(), it % 2 == 0, blocks);
     return maxDelta;
   }
-  buildCompact(rows, *blocks);
+  buildCompact(rows, bodies, *blocks);
   const std::vector<PgsBlocks::Unit>& plan = blocks->plan;
   auto visit = [&](const PgsBlocks::Unit& u, bool forward) -> Real {
     if (u.manifold < 0) return sweepRows(rows, bodies, u.begin, u.end, forward, blocks);
     PgsBlocks::Manifold& m = blocks->manifolds[size_t(u.manifold)];
-    const PgsBlocks::Point* P = blocks->points.data() + m.point;
     VisitBodies V(m, bodies);
     Real d;
     if (forward) {
-      d = compactFriction(m, P, V, true);
+      d = compactFriction(m, V, true);
       d = std::max(d, compactBlock(*blocks, m, rows, bodies, V, true));
     } else {
       d = compactBlock(*blocks, m, rows, bodies, V, false);
-      d = std::max(d, compactFriction(m, P, V, false));
+      d = std::max(d, compactFriction(m, V, false));
     }
     V.store(m, bodies);
     return d;
@@ -975,6 +1036,37 @@ bool PgsSolver::solveSupportExactly(std::vector<ConstraintRow>& rows, std::vecto
 // The support solve above on a compact manifold record (PgsSolver::iterate): the same system, its operators
 // read as 6-vectors, the impulses read from and written to the ConstraintRows (the shock pass's state).
 namespace {
+/// Solves K x = b for a symmetric positive definite 6 x 6 K (lower triangle read) by an unrolled Cholesky
+/// factorisation; false when a pivot is not positive (as Eigen::LLT reports). Written out because Eigen's
+/// general LLT was 0.39 M of pyramid20's 10.3 M instructions per step (one solve per shock support).
+bool choleskySolve6(const Real K[6][6], const Real b[6], Real x[6]) {
+  Real L[6][6], inv[6];
+  for (int j = 0; j < 6; ++j) {
+    Real d = K[j][j];
+    for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
+    if (!(d > 0)) return false;
+    const Real ljj = std::sqrt(d);
+    inv[j] = 1 / ljj;
+    for (int i = j + 1; i < 6; ++i) {
+      Real s = K[i][j];
+      for (int k = 0; k < j; ++k) s -= L[i][k] * L[j][k];
+      L[i][j] = s * inv[j];
+    }
+  }
+  Real y[6];
+  for (int i = 0; i < 6; ++i) {
+    Real s = b[i];
+    for (int k = 0; k < i; ++k) s -= L[i][k] * y[k];
+    y[i] = s * inv[i];
+  }
+  for (int i = 6; i-- > 0;) {
+    Real s = y[i];
+    for (int k = i + 1; k < 6; ++k) s -= L[k][i] * x[k];
+    x[i] = s * inv[i];
+  }
+  return std::isfinite(x[0] + x[1] + x[2] + x[3] + x[4] + x[5]);
+}
+
 bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                          const PgsSolver::ShockRange& sr, const PgsBlocks& pb, const PgsBlocks::Manifold& m) {
   constexpr int kM = 6;
@@ -986,19 +1078,23 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   const PgsBlocks::Point* P = pb.points.data() + m.point;
   ConstraintRow* F = rows.data() + m.row;
   ConstraintRow* R = F + 3;
-  const Vec6* G[kM];
-  const Vec6* W[kM];
-  for (int a = 0; a < 3; ++a) {
-    G[a] = freeA ? &m.gA[a] : &m.gB[a];
-    W[a] = freeA ? &m.wA[a] : &m.wB[a];
-    G[3 + a] = freeA ? &m.f[a].jA : &m.f[a].jB;
-    W[3 + a] = freeA ? &m.f[a].wA : &m.f[a].wB;
+  // The six rows on the free body (rows 0..2 the block's coordinates, 3..5 the friction rows): G = [lin; ang],
+  // W = M^-1 G^T. Rows 0, 3 and 4 have a linear part (the B side's is the A side's negated, which the product
+  // G W^T does not see); the angular parts are the free side's half of the record's [A; B] 6-vectors.
+  const Real im = freeA ? m.imA : m.imB;
+  const int side = freeA ? 0 : 3;
+  constexpr int kLinRow[3] = {0, 3, 4};
+  Real K[kM][kM];
+  for (int a = 0; a < kM; ++a) {
+    const Real* ga = m.ang[a].data() + side;
+    for (int c = 0; c <= a; ++c) {
+      const Real* wc = m.w[c].data() + side;
+      K[a][c] = ga[0] * wc[0] + ga[1] * wc[1] + ga[2] * wc[2];
+    }
   }
-  Eigen::Matrix<Real, kM, kM> K;
-  for (int a = 0; a < kM; ++a)
-    for (int c = 0; c <= a; ++c) K(a, c) = K(c, a) = G[a]->dot(*W[c]);
+  for (int p = 0; p < 3; ++p)
+    for (int q = 0; q <= p; ++q) K[kLinRow[p]][kLinRow[q]] += im * m.lin[p].dot(m.lin[q]);
   // Regularisation: the block's D E D^T, the friction rows' own e.
-  Real dE[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   Real b[kM];
   for (int a = 0; a < 3; ++a) b[a] = m.dRhs[a];
   for (int i = 0; i < n; ++i) {
@@ -1006,44 +1102,34 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
     const Real e = P[i].e, el = e * R[i].lambda;
     for (int a = 0; a < 3; ++a) {
       b[a] -= D[a] * el;
-      for (int c = 0; c < 3; ++c) dE[a][c] += D[a] * e * D[c];
+      for (int c = 0; c <= a; ++c) K[a][c] += D[a] * e * D[c];
     }
   }
-  for (int a = 0; a < 3; ++a)
-    for (int c = 0; c < 3; ++c) K(a, c) += dE[a][c];
-  for (int k = 0; k < 3; ++k) K(3 + k, 3 + k) += m.f[k].e;
+  for (int k = 0; k < 3; ++k) K[3 + k][3 + k] += m.e[k];
   // Residuals (velocities of both bodies, as in the sweeps).
-  if (m.a >= 0) {
-    const Vec6 V = velocity(bodies, m.a);
-    for (int a = 0; a < 3; ++a) b[a] -= m.gA[a].dot(V);
-    for (int k = 0; k < 3; ++k) b[3 + k] = m.f[k].rhs - m.f[k].jA.dot(V);
-  } else {
-    for (int k = 0; k < 3; ++k) b[3 + k] = m.f[k].rhs;
-  }
-  if (m.b >= 0) {
-    const Vec6 V = velocity(bodies, m.b);
-    for (int a = 0; a < 3; ++a) b[a] -= m.gB[a].dot(V);
-    for (int k = 0; k < 3; ++k) b[3 + k] -= m.f[k].jB.dot(V);
-  }
-  for (int k = 0; k < 3; ++k) b[3 + k] -= m.f[k].e * F[k].lambda;
+  const VisitBodies V(m, bodies);
+  b[0] -= V.rowVelocity(m.lin[0], m.ang[0]);
+  b[1] -= m.ang[1].dot(V.w);
+  b[2] -= m.ang[2].dot(V.w);
+  b[3] = m.rhs[0] - V.rowVelocity(m.lin[1], m.ang[3]);
+  b[4] = m.rhs[1] - V.rowVelocity(m.lin[2], m.ang[4]);
+  b[5] = m.rhs[2] - m.ang[5].dot(V.w);
+  for (int k = 0; k < 3; ++k) b[3 + k] -= m.e[k] * F[k].lambda;
   // A degenerate axis carries nothing (as in the block).
   for (int a = 1; a < 3; ++a)
     if (!(a == 1 ? m.axisU : m.axisV)) {
-      K.row(a).setZero();
-      K.col(a).setZero();
-      K(a, a) = 1;
+      for (int c = 0; c < kM; ++c) K[a][c] = K[c][a] = 0;
+      K[a][a] = 1;
       b[a] = 0;
     }
-  const Eigen::LLT<Eigen::Matrix<Real, kM, kM>> llt(K);
-  if (llt.info() != Eigen::Success) return false;
-  const Eigen::Matrix<Real, kM, 1> x = llt.solve(Eigen::Map<const Eigen::Matrix<Real, kM, 1>>(b));
-  if (!x.allFinite()) return false;
+  Real x[kM];
+  if (!choleskySolve6(K, b, x)) return false;
   // Bounds: the new normal impulses, then the friction inside mu times their new sum.
   Real nl[kMaxNormalBlock];
   Real sumN = 0;
   for (int i = 0; i < n; ++i) {
     nl[i] = R[i].lambda + x[0] + x[1] * P[i].u + x[2] * P[i].v;
-    if (nl[i] < P[i].lo || nl[i] > P[i].hi) return false;
+    if (nl[i] < P[i].lo) return false;
     sumN += std::max<Real>(nl[i], 0);
   }
   Real fl[3];
@@ -1057,9 +1143,11 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   if (std::abs(fl[2]) > frictionLimit(m.muTwist, sumN)) return false;
   for (int i = 0; i < n; ++i) R[i].lambda = nl[i];
   for (int k = 0; k < 3; ++k) F[k].lambda = fl[k];
-  Vec6 dV = Vec6::Zero();
-  for (int a = 0; a < kM; ++a) dV += *W[a] * x[a];
-  velocity(bodies, fb) += dV;
+  Vec6 dw = Vec6::Zero();
+  for (int a = 0; a < kM; ++a) dw += m.w[a] * x[a];
+  const Vec3 dl = m.lin[0] * x[0] + m.lin[1] * x[3] + m.lin[2] * x[4];
+  bodies[size_t(fb)].v += (freeA ? im : -im) * dl;
+  bodies[size_t(fb)].w += dw.segment<3>(side);
   return true;
 }
 

@@ -47,34 +47,46 @@ struct PgsBlocks {
   std::vector<Block> blocks;
 
   // ---- issue 18 (compact contact arrays; pgs.cpp "Compact manifold sweeps", docs/solver-internals.md) ----
-  /// A body's (v, w) or a row's Jacobian on one body, [linear; angular]: six doubles that SSE2 handles as three
-  /// packets of two, where two Vec3 take six scalar operations.
+  /// A manifold contact (contact_rows.h: [t1, t2, twist][normal block]) swept as one unit: every datum a visit
+  /// reads lies in this record and its points. Six rows act on the two bodies: the normal block's coordinates
+  /// (centre, tilt u, tilt v: Block::g/w) and the friction rows (t1, t2, twist). Compact layout (issue 18,
+  /// fourth round, docs/solver-internals.md "Compact contact rows"):
+  ///  - linear parts once per manifold and only where a row has one: a contact row's J_linB = -J_linA, so each
+  ///    row's linear part is one A-side direction against the relative velocity v_A - v_B, and M^-1 J_lin^T is
+  ///    that direction times the body's inverse mass. The tilt coordinates' linear part sum_i u_i n_i vanishes
+  ///    (u, v are centred) and the twist row has none: three directions (the block centre's sum of normals, t1,
+  ///    t2) serve all six rows;
+  ///  - per row only the angular parts J_ang and I^-1 J_ang^T, both bodies' as one 6-vector [A; B] that a visit
+  ///    dots with the bodies' angular velocities (w_A; w_B) held as one 6-vector (SSE2: three packets of two);
+  ///  - per point its block coordinates, compliance, impulse and lower bound (40 bytes; contact normal rows
+  ///    have no upper bound). The compliance stays per point: a tilted manifold mixes touching points (SPOOK's
+  ///    e) with speculative ones (e = 0).
+  /// Double precision throughout: the compact sweeps must give the ConstraintRow sweeps' impulses to 1e-9
+  /// (test_unit_compact_sweeps), which float Jacobians (6e-8 relative) do not.
   using Vec6 = Eigen::Matrix<Real, 6, 1>;
-  /// One friction row of a manifold ([t1, t2, twist] at its centre, contact_rows.h) as the sweeps read it: J and
-  /// W = M^-1 J^T on each body.
-  struct FrictionRow {
-    Vec6 jA, jB, wA, wB;
-    Real rhs, e, invDiag, lambda;
-  };
-  /// A manifold contact (its three friction rows and its normal block) swept as one unit: every datum a visit
-  /// reads lies in this record and its points (one 48-byte Point per normal row); the block operators are the
-  /// Block's (both bodies free), in Vec6 form.
   struct Manifold {
-    FrictionRow f[3];
-    Vec6 gA[3], gB[3], wA[3], wB[3];  ///< Block::gLin/gAng and wLin/wAng per coordinate
-    Real dRhs[3], sInv[6];            ///< Block::dRhs, Block::sInv[0]
-    int32_t a, b;                     ///< solver bodies (-1: static)
-    uint32_t row;                     ///< ConstraintRow of t1; t2 = row + 1, twist = row + 2, normals from row + 3
-    uint32_t block;                   ///< slot in blocks
-    uint32_t point;                   ///< first of its n entries in points
-    int32_t n;                        ///< normal rows
-    bool cone;                        ///< t1, t2 a projected-cone pair (else two scaled-box rows)
-    bool ok, axisU, axisV;            ///< Block::ok[0], axisU, axisV
-    Real mu, muTwist;                 ///< friction coefficients of the pair and the twist (ConstraintRow::mu)
+    Vec6 ang[6];             ///< angular J [A; B] per row: 0..2 block (centre, u, v), 3..5 friction (t1, t2, twist)
+    Vec6 w[6];               ///< I^-1 J_ang^T [A; B] per row
+    Vec3 lin[3];             ///< A-side linear J: block centre (row 0), t1 (row 3), t2 (row 4); B side negated
+    Real imA, imB;           ///< the bodies' inverse masses (0: static)
+    Real rhs[3], e[3], invDiag[3], lambda[3];  ///< friction rows t1, t2, twist
+    Real dRhs[3], sInv[6];   ///< Block::dRhs, Block::sInv[0]
+    /// Sums over the points, kept with their impulses (one pass when a block update is accepted, instead of
+    /// two loops per visit): sum e lambda, sum e lambda u, sum e lambda v (the compliances' term of the block's
+    /// residual) and sum max(lambda, 0) (the friction bound, boundingNormal).
+    Real sl, slu, slv, sumN;
+    Real mu, muTwist;        ///< friction coefficients of the pair and the twist (ConstraintRow::mu)
+    int32_t a, b;            ///< solver bodies (-1: static)
+    uint32_t row;            ///< ConstraintRow of t1; t2 = row + 1, twist = row + 2, normals from row + 3
+    uint32_t block;          ///< slot in blocks
+    uint32_t point;          ///< first of its n entries in points
+    int32_t n;               ///< normal rows
+    bool cone;               ///< t1, t2 a projected-cone pair (else two scaled-box rows)
+    bool ok, axisU, axisV;   ///< Block::ok[0], axisU, axisV
   };
-  /// A normal row of a manifold block: its block coordinates, compliance, impulse and bounds.
+  /// A normal row of a manifold block: its block coordinates, compliance, impulse and lower bound.
   struct Point {
-    Real u, v, e, lambda, lo, hi;
+    Real u, v, e, lambda, lo;
   };
   /// The serial sweep's visiting order: a compact manifold (manifold >= 0) or the ConstraintRows [begin, end)
   /// swept row by row (joints, per-point contacts, anything not of the manifold form).
