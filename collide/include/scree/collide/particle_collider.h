@@ -58,8 +58,11 @@ class ParticleCollider {
   const std::vector<ParticleContact>& getParticleGeometryContacts() const { return pg_; }
   std::vector<ParticleContact>& getParticleGeometryContacts() { return pg_; }
 
-  /// Grid cell size of the last collide(), m: no particle pair in contact is farther apart than this.
+  /// Grid cell size of the last collide(), m: no particle pair in contact is farther apart than this
+  /// (2 maxR + the reach; the two-speed grid's own cell may be smaller).
   Real getCellSize() const;
+  /// Particles the last collide() searched as fast (see "Two-speed grid"; 0 when every particle was slow).
+  size_t getNumFastParticles() const;
 
   /// A permutation (for GranularBodySystem::reorder) that sorts particles along the grid (cells in z, y, x
   /// order), so neighbours in space are near in memory. Uses the grid of the last collide().
