@@ -29,7 +29,7 @@ constexpr size_t kParallelChunks = 4;
 constexpr size_t kDenseCellsPerParticle = 32;
 // Two-speed grid (see "Two-speed grid" in the header): a particle is slow when its speed relative to the
 // reference velocity, times h, is at most kSlowShare largest radii.
-constexpr Real kSlowShare = 0.1;
+constexpr Real kSlowShare = 0.25;
 
 #if defined(__GNUC__)
 #define SCREE_PAIR_INLINE __attribute__((always_inline))
