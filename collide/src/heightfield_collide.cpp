@@ -803,8 +803,9 @@ int collideSphereHeightField(const Shape& s0, const Transform& t0, const Shape& 
   const Real zReach = (r + margin) * (1 + Real(1e-9));
   for (long j = j0; j <= j1; ++j)
     for (long i = i0; i <= i1; ++i) {
-      const Real zTop = std::max(std::max(g.hf.getHeight(size_t(i), size_t(j)), g.hf.getHeight(size_t(i + 1), size_t(j))),
-                                 std::max(g.hf.getHeight(size_t(i), size_t(j + 1)), g.hf.getHeight(size_t(i + 1), size_t(j + 1))));
+      const size_t ui = size_t(i), uj = size_t(j);
+      const Real zTop = std::max(std::max(g.hf.getHeight(ui, uj), g.hf.getHeight(ui + 1, uj)),
+                                 std::max(g.hf.getHeight(ui, uj + 1), g.hf.getHeight(ui + 1, uj + 1)));
       if (rel.p.z() - zTop > zReach) continue;
       for (int t = 0; t < 2; ++t) sphereTriangle(g, i, j, t, rel.p, r, margin, -1, out);
     }
