@@ -796,9 +796,19 @@ int collideSphereHeightField(const Shape& s0, const Transform& t0, const Shape& 
   long i0, i1, j0, j1;
   if (!footprint(s0, rel, g, margin, i0, i1, j0, j1)) return 0;
   const size_t begin = out.size();
+  // A cell whose four vertices all lie more than r + margin below the centre cannot touch the sphere (every
+  // point of its triangles is at least that far away): skipped without building its triangles. The 1e-9
+  // relative slack keeps the skip conservative against rounding, so the contacts are exactly those of the full
+  // loop (particles resting on or above a terrain cell meet this test most).
+  const Real zReach = (r + margin) * (1 + Real(1e-9));
   for (long j = j0; j <= j1; ++j)
-    for (long i = i0; i <= i1; ++i)
+    for (long i = i0; i <= i1; ++i) {
+      const size_t ui = size_t(i), uj = size_t(j);
+      const Real zTop = std::max(std::max(g.hf.getHeight(ui, uj), g.hf.getHeight(ui + 1, uj)),
+                                 std::max(g.hf.getHeight(ui, uj + 1), g.hf.getHeight(ui + 1, uj + 1)));
+      if (rel.p.z() - zTop > zReach) continue;
       for (int t = 0; t < 2; ++t) sphereTriangle(g, i, j, t, rel.p, r, margin, -1, out);
+    }
   return finish(out, begin, t1);
 }
 

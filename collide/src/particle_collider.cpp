@@ -26,7 +26,10 @@ constexpr size_t kChunk = 512;
 constexpr size_t kParallelChunks = 4;
 // The dense grid is used while the live cells' padded bounding box has at most this many cells per particle
 // (plus 4096): its cell-start array is then a few times the particle arrays at most.
-constexpr size_t kDenseCellsPerParticle = 8;
+constexpr size_t kDenseCellsPerParticle = 32;
+// Two-speed grid (see "Two-speed grid" in the header): a particle is slow when its speed relative to the
+// reference velocity, times h, is at most kSlowShare largest radii.
+constexpr Real kSlowShare = 0.25;
 
 #if defined(__GNUC__)
 #define SCREE_PAIR_INLINE __attribute__((always_inline))
@@ -71,9 +74,10 @@ struct ParticleCollider::Impl {
   struct Entry {
     Vec3 x;
     Real r;
-    Real s;  // h |v| (1 + 1e-9): see the pair test
+    Real w;  // the speed bound w_j (see the pair search)
     int32_t cx, cy, cz;
     uint32_t j;
+    uint32_t fast;  // 1: searches its own partners (w_j > the slow bound)
   };
   std::vector<Entry> entries;               // [sorted.size()]
   std::vector<std::vector<ParticleContact>> chunkOut;  // per chunk
@@ -94,6 +98,12 @@ struct ParticleCollider::Impl {
   int32_t lo[3] = {0, 0, 0}, hi[3] = {-1, -1, -1};  // live cells' bounds (cell coordinates)
   int64_t nx = 0, nxy = 0;                          // padded row length and layer size
   std::vector<uint32_t> posOf;                      // [size()] index of a particle in sorted (dense grid only)
+  // ---- two-speed grid ----
+  Real gcell = 1, ginvCell = 1;  // the grid's cell (cell/invCell above are the reported 2 maxR + reach)
+  std::vector<Real> w;           // [size()] speed bounds
+  std::vector<uint32_t> fastList;  // the fast live particles, ascending
+  std::vector<Vec3> xLast;       // positions of the last collide (localityOrder's cells)
+  std::vector<Real> vScratch;    // median of the velocities
 
   int64_t denseCell(int64_t x, int64_t y, int64_t z) const {
     return ((z - lo[2]) * (nxy / nx) + (y - lo[1] + 1)) * nx + (x - lo[0] + 1);
@@ -136,17 +146,42 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
   maxV = std::sqrt(maxV);
   // Pair margin reach: relative speed of two particles is at most 2 maxV; capped at one diameter (see header).
   const Real reach = std::min(2 * maxV * h + margin_, 2 * maxR);
+  // The reported cell (getCellSize, localityOrder): the largest distance of a pair in contact.
   m.cell = 2 * maxR + reach;
   m.invCell = 1.0 / m.cell;
+  m.xLast.assign(x.begin(), x.end());
+  // Two-speed grid (header). Reference velocity u: the median of the live particles' velocities, component by
+  // component (an element of the data: exact, and the same on any thread count). Speed bound of a particle:
+  //   w_i = h |v_i - u| (1 + 1e-9),  so  h |v_i - v_j| <= w_i + w_j  (triangle inequality; the 1e-9 is far more
+  // than the rounding of either side, so the bound holds in floating point too).
+  Vec3 u = Vec3::Zero();
+  for (int ax = 0; ax < 3; ++ax) {
+    auto& q = m.vScratch;
+    q.clear();
+    for (size_t i = 0; i < n; ++i)
+      if (ps.isAliveDense(i)) q.push_back(v[i][ax]);
+    if (q.empty()) continue;
+    std::nth_element(q.begin(), q.begin() + long(q.size() / 2), q.end());
+    u[ax] = q[q.size() / 2];
+  }
+  m.w.resize(n);
+  for (size_t i = 0; i < n; ++i) m.w[i] = h * (v[i] - u).norm() * (1 + 1e-9);
+  // Slow particles (w <= slowW): any two of them are within the grid cell when in contact, so they find each
+  // other through the half stencil. When the reach itself fits (a pile at rest), every particle is slow.
+  const Real slowW = kSlowShare * maxR;
+  const Real slowReach = std::min(2 * slowW + margin_, reach);
+  const bool twoSpeed = reach > slowReach;
+  m.gcell = (2 * maxR + slowReach) * (1 + 1e-9);
+  m.ginvCell = 1.0 / m.gcell;
   m.cx.resize(n);
   m.cy.resize(n);
   m.cz.resize(n);
   m.bucketOf.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelChunks * kChunk)
   for (size_t i = 0; i < n; ++i) {
-    m.cx[i] = cellCoord(x[i].x(), m.invCell);
-    m.cy[i] = cellCoord(x[i].y(), m.invCell);
-    m.cz[i] = cellCoord(x[i].z(), m.invCell);
+    m.cx[i] = cellCoord(x[i].x(), m.ginvCell);
+    m.cy[i] = cellCoord(x[i].y(), m.ginvCell);
+    m.cz[i] = cellCoord(x[i].z(), m.ginvCell);
   }
   // Dense grid: the live cells' bounding box, padded, when it is small enough (a particle flung far away makes
   // it large: then the hashed grid). Both give the same contact list (the pairs are sorted below).
@@ -191,6 +226,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
     if (ps.isAliveDense(i)) ++m.bucketStart[m.bucketOf[i] + 1];
   for (size_t b = 0; b < table; ++b) m.bucketStart[b + 1] += m.bucketStart[b];
   m.sorted.resize(m.bucketStart[table]);
+  m.fastList.clear();
   {
     std::vector<uint32_t>& fill = m.candidates;  // reuse as a cursor array
     fill.assign(m.bucketStart.begin(), m.bucketStart.end() - 1);
@@ -199,18 +235,24 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
     m.entries.resize(m.sorted.size());
     for (size_t k = 0; k < m.sorted.size(); ++k) {
       const uint32_t j = m.sorted[k];
-      m.entries[k] = {x[j], r[j], h * v[j].norm() * (1 + 1e-9), m.cx[j], m.cy[j], m.cz[j], j};
+      const uint32_t fast = twoSpeed && m.w[j] > slowW ? 1u : 0u;
+      m.entries[k] = {x[j], r[j], m.w[j], m.cx[j], m.cy[j], m.cz[j], j, fast};
       if (m.dense) m.posOf[j] = uint32_t(k);
     }
+    for (size_t i = 0; i < n; ++i)
+      if (twoSpeed && ps.isAliveDense(i) && m.w[i] > slowW) m.fastList.push_back(uint32_t(i));
   }
 
   // ---- particle pairs ----------------------------------------------------------------------------------------
-  // Half stencil: a particle looks at its own cell (partners of higher index only) and the 13 neighbour cells
-  // that come after its own in (z, y, x) order, so each pair of cells is visited from one side only (the full
-  // 27-cell stencil met every candidate pair twice and rejected one visit by index). A pair found from the
-  // higher particle's side is stored as (lower, higher); the pairs are then put in (a, b) order by a counting
-  // sort on a and a sort of each a's few partners, and the contacts are computed from a's side exactly as
-  // before (d = x_a - x_b): the same contact list in the same order, bit for bit.
+  // Slow particles: half stencil. A slow particle looks at its own cell (partners of higher index only) and the
+  // 13 neighbour cells that come after its own in (z, y, x) order, so each pair of cells is visited from one
+  // side only, and it skips fast partners (they find it). A pair found from the higher particle's side is
+  // stored as (lower, higher); the pairs are then put in (a, b) order by a counting sort on a and a sort of each
+  // a's few partners, and the contacts are computed from a's side (d = x_a - x_b): the same contact list in the
+  // same order, bit for bit, whichever particle found the pair.
+  // Fast particles (w_i > slowW): a full search of every cell within R_i = r_i + maxR + min(2 w_i + margin,
+  // reach) (the farthest partner of speed bound <= w_i), taking slow partners and fast partners of lower bound
+  // (equal bounds: of higher index), so each pair with a fast particle is found once, by its faster particle.
   const size_t numChunks = (n + kChunk - 1) / kChunk;
   if (m.chunkPairs.size() < numChunks) m.chunkPairs.resize(numChunks);
 #pragma omp parallel for schedule(dynamic, 1) if (numChunks >= kParallelChunks)
@@ -222,10 +264,80 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
       if (!ps.isAliveDense(i)) continue;
       const Vec3 xi = x[i];
       const Real ri = r[i];
-      const Real si = h * v[i].norm() * (1 + 1e-9) + margin_;
-      // Position of the centre within its cell, in cells: a neighbour cell whose nearest point is at least one
-      // cell (>= r_i + r_j + reach) away holds no candidate, so it is not visited (about a quarter of them).
-      const Vec3 f = xi * m.invCell - Vec3(m.cx[i], m.cy[i], m.cz[i]);
+      const Real wi = m.w[i];
+      const bool fastI = twoSpeed && wi > slowW;
+      // Position of the centre within its cell, in cells.
+      const Vec3 f = xi * m.ginvCell - Vec3(m.cx[i], m.cy[i], m.cz[i]);
+      // A candidate j at entry e: the same tests whichever grid found it.
+      auto test = [&](const Impl::Entry& e) SCREE_PAIR_INLINE {
+        const uint32_t j = e.j;
+        const Vec3 d = xi - e.x;  // the negative of x_j - x_i: the same squared norm
+        const Real dist2 = d.squaredNorm();
+        // Cheap reject first: beyond ri + rj + min(w_i + w_j + margin, reach) the pair cannot touch (the bound
+        // above; floating-point addition is monotone, so far >= lim below and the reject never drops a pair the
+        // exact test keeps); the relative speed (a square root) is read only for the rest.
+        const Real far = ri + e.r + std::min(wi + e.w + margin_, reach);
+        if (dist2 >= far * far) return;
+        const Real pairMargin = std::min(h * (v[i] - v[j]).norm() + margin_, reach);
+        const Real lim = ri + e.r + pairMargin;
+        if (dist2 >= lim * lim) return;
+        out.push_back(j > i ? std::make_pair(uint32_t(i), j) : std::make_pair(j, uint32_t(i)));
+      };
+      if (fastI) {
+        auto take = [&](const Impl::Entry& e) SCREE_PAIR_INLINE {
+          if (e.j == i) return;
+          if (e.fast && (e.w > wi || (e.w == wi && e.j < i))) return;
+          test(e);
+        };
+        // Reach in cells, with 1e-6 cell of slack for the rounding of the cell coordinates.
+        const Real reachCells = (ri + maxR + std::min(2 * wi + margin_, reach)) * m.ginvCell * (1 + 1e-9) + 1e-6;
+        const Real reach2 = reachCells * reachCells;
+        const int K = int(std::ceil(reachCells));
+        // Squared distance in cells from the centre to the slab at offset o along an axis.
+        auto gap2 = [&](int ax, int o) {
+          const Real g = o < 0 ? f[ax] + Real(-o - 1) : o > 0 ? Real(1) - f[ax] + Real(o - 1) : Real(0);
+          const Real gp = std::max<Real>(g, 0);
+          return gp * gp;
+        };
+        for (int dz = -K; dz <= K; ++dz) {
+          const Real gz = gap2(2, dz);
+          if (gz >= reach2) continue;
+          for (int dy = -K; dy <= K; ++dy) {
+            const Real gyz = gz + gap2(1, dy);
+            if (gyz >= reach2) continue;
+            int x0 = -K, x1 = K;
+            while (x0 < 0 && gyz + gap2(0, x0) >= reach2) ++x0;
+            while (x1 > 0 && gyz + gap2(0, x1) >= reach2) --x1;
+            const int64_t qy = int64_t(m.cy[i]) + dy, qz = int64_t(m.cz[i]) + dz;
+            if (m.dense) {
+              if (qy < m.lo[1] || qy > m.hi[1] || qz < m.lo[2] || qz > m.hi[2]) continue;
+              const int64_t qx0 = std::max<int64_t>(int64_t(m.cx[i]) + x0, m.lo[0]);
+              const int64_t qx1 = std::min<int64_t>(int64_t(m.cx[i]) + x1, m.hi[0]);
+              if (qx0 > qx1) continue;
+              const uint32_t k0 = m.bucketStart[size_t(m.denseCell(qx0, qy, qz))];
+              const uint32_t k1 = m.bucketStart[size_t(m.denseCell(qx1, qy, qz)) + 1];
+              for (uint32_t k = k0; k < k1; ++k) take(m.entries[k]);
+              continue;
+            }
+            for (int dx = x0; dx <= x1; ++dx) {
+              const int64_t qx = int64_t(m.cx[i]) + dx;
+              const size_t b = hashCell(qx, qy, qz) & m.tableMask;
+              for (uint32_t k = m.bucketStart[b]; k < m.bucketStart[b + 1]; ++k) {
+                const Impl::Entry& e = m.entries[k];
+                if (e.cx != qx || e.cy != qy || e.cz != qz) continue;
+                take(e);
+              }
+            }
+          }
+        }
+        continue;
+      }
+      auto takeSlow = [&](const Impl::Entry& e) SCREE_PAIR_INLINE {
+        if (e.fast) return;
+        test(e);
+      };
+      // A neighbour cell whose nearest point is at least one cell (more than r_i + r_j + the slow reach) away
+      // holds no partner, so it is not visited (about a quarter of them).
       Real gap2[3][3];  // [axis][offset + 1]: squared distance (cells) to the neighbour slab along the axis
       for (int ax = 0; ax < 3; ++ax) {
         const Real lo = std::max<Real>(f[ax], 0), hi = std::max<Real>(1 - f[ax], 0);
@@ -233,30 +345,13 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
         gap2[ax][1] = 0;
         gap2[ax][2] = hi * hi;
       }
-      // A candidate j at entry e: the same tests whichever grid found it.
-      auto test = [&](const Impl::Entry& e) SCREE_PAIR_INLINE {
-        const uint32_t j = e.j;
-        const Vec3 d = xi - e.x;  // the negative of x_j - x_i: the same squared norm
-        const Real dist2 = d.squaredNorm();
-        // Cheap reject first: beyond the largest margin (reach) the pair can never touch, and most
-        // stencil candidates are that far; the relative speed (a square root) is read only for the rest.
-        // The bound uses h |v_i - v_j| <= h |v_i| + h |v_j|: the speeds are taken 1e-9 larger, far more than
-        // the rounding of either side, so far >= lim below in floating point too and the reject never drops a
-        // pair the exact test keeps (the contact list is the same as with the reach alone).
-        const Real far = ri + e.r + std::min(si + e.s, reach);
-        if (dist2 >= far * far) return;
-        const Real pairMargin = std::min(h * (v[i] - v[j]).norm() + margin_, reach);
-        const Real lim = ri + e.r + pairMargin;
-        if (dist2 >= lim * lim) return;
-        out.push_back(j > i ? std::make_pair(uint32_t(i), j) : std::make_pair(j, uint32_t(i)));
-      };
       if (m.dense) {
         // Dense grid: the own cell after i's entry (the partners of higher index: a cell's entries are in
         // dense order) and, when in reach, the cell x+1 of the same row; then the rows (y+1, z) and
         // (y-1..y+1, z+1), each from x-1 to x+1 trimmed by the same one-cell rule. A row is one contiguous run.
         const int64_t c = int64_t(m.bucketOf[i]);
         const uint32_t own1 = m.bucketStart[size_t(c) + (gap2[0][2] < 1 ? 2 : 1)];
-        for (uint32_t k = m.posOf[i] + 1; k < own1; ++k) test(m.entries[k]);
+        for (uint32_t k = m.posOf[i] + 1; k < own1; ++k) takeSlow(m.entries[k]);
         for (int dz = 0; dz <= 1; ++dz)
           for (int dy = dz == 0 ? 1 : -1; dy <= 1; ++dy) {
             const Real g = gap2[1][dy + 1] + gap2[2][dz + 1];
@@ -264,7 +359,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
             const int64_t row = c + dz * m.nxy + dy * m.nx;
             const uint32_t k0 = m.bucketStart[size_t(row + (g + gap2[0][0] < 1 ? -1 : 0))];
             const uint32_t k1 = m.bucketStart[size_t(row + (g + gap2[0][2] < 1 ? 2 : 1))];
-            for (uint32_t k = k0; k < k1; ++k) test(m.entries[k]);
+            for (uint32_t k = k0; k < k1; ++k) takeSlow(m.entries[k]);
           }
         continue;
       }
@@ -278,7 +373,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
             for (uint32_t k = m.bucketStart[b]; k < m.bucketStart[b + 1]; ++k) {
               const Impl::Entry& e = m.entries[k];
               if ((own && e.j <= i) || e.cx != qx || e.cy != qy || e.cz != qz) continue;
-              test(e);
+              takeSlow(e);
             }
           }
     }
@@ -352,13 +447,13 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
     Aabb clip;
     clip.lo = box.lo.cwiseMax(cloud.lo);
     clip.hi = box.hi.cwiseMin(cloud.hi);
-    const Vec3 cells = ((clip.hi - clip.lo) * m.invCell).array() + 2.0;
+    const Vec3 cells = ((clip.hi - clip.lo) * m.ginvCell).array() + 2.0;
     auto& cand = m.candidates;
     cand.clear();
     if (cells.x() * cells.y() * cells.z() < Real(n)) {
-      const int64_t x0 = cellCoord(clip.lo.x(), m.invCell), x1 = cellCoord(clip.hi.x(), m.invCell);
-      const int64_t y0 = cellCoord(clip.lo.y(), m.invCell), y1 = cellCoord(clip.hi.y(), m.invCell);
-      const int64_t z0 = cellCoord(clip.lo.z(), m.invCell), z1 = cellCoord(clip.hi.z(), m.invCell);
+      const int64_t x0 = cellCoord(clip.lo.x(), m.ginvCell), x1 = cellCoord(clip.hi.x(), m.ginvCell);
+      const int64_t y0 = cellCoord(clip.lo.y(), m.ginvCell), y1 = cellCoord(clip.hi.y(), m.ginvCell);
+      const int64_t z0 = cellCoord(clip.lo.z(), m.ginvCell), z1 = cellCoord(clip.hi.z(), m.ginvCell);
       for (int64_t cz = z0; cz <= z1; ++cz)
         for (int64_t cy = y0; cy <= y1; ++cy)
           for (int64_t cx = x0; cx <= x1; ++cx) m.forCell(cx, cy, cz, [&](uint32_t j) { cand.push_back(j); });
@@ -411,17 +506,26 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
 }
 
 Real ParticleCollider::getCellSize() const { return impl_->cell; }
+size_t ParticleCollider::getNumFastParticles() const { return impl_->fastList.size(); }
 
 std::vector<uint32_t> ParticleCollider::localityOrder(const GranularBodySystem& ps) const {
   const Impl& m = *impl_;
   const size_t n = ps.size();
   std::vector<uint32_t> order(n);
   for (size_t i = 0; i < n; ++i) order[i] = uint32_t(i);
-  if (m.cx.size() != n) return order;
+  if (m.xLast.size() != n) return order;
+  // The cells of the reported cell size (2 maxR + reach), not the two-speed grid's: the order is the same as
+  // before that grid existed, so results do not change.
+  std::vector<int32_t> cx(n), cy(n), cz(n);
+  for (size_t i = 0; i < n; ++i) {
+    cx[i] = cellCoord(m.xLast[i].x(), m.invCell);
+    cy[i] = cellCoord(m.xLast[i].y(), m.invCell);
+    cz[i] = cellCoord(m.xLast[i].z(), m.invCell);
+  }
   std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-    if (m.cz[a] != m.cz[b]) return m.cz[a] < m.cz[b];
-    if (m.cy[a] != m.cy[b]) return m.cy[a] < m.cy[b];
-    return m.cx[a] < m.cx[b];
+    if (cz[a] != cz[b]) return cz[a] < cz[b];
+    if (cy[a] != cy[b]) return cy[a] < cy[b];
+    return cx[a] < cx[b];
   });
   return order;
 }
