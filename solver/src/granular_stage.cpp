@@ -128,7 +128,6 @@ void radixSortBy(std::vector<T>& v, std::vector<T>& tmp, int bits, KeyOf digitKe
 // or without AVX2, the scalar sweep runs in unit order. test_unit_granular_system compares both bit for bit.
 bool gVectorSweepEnabled = true;
 std::atomic<uint64_t> gPackedUnits{0};  // packedUnitsTotal
-std::atomic<uint64_t> gShockPackedUnits{0};  // shockPackedUnitsTotal
 // Packets per kernel call (1-4): independent packets of one level solved together overlap their latencies.
 constexpr size_t kPacketRun = SCREE_PACKET_RUN;
 
@@ -339,125 +338,6 @@ SCREE_AVX2 __attribute__((noinline)) Real solvePacketsAvx2(GranularStage::Packet
   return std::max(std::max(ad[0], ad[1]), std::max(ad[2], ad[3]));
 }
 
-// ---- Four-wide shock pass (issue 16, trench speed, seventh round; see shockPass) ----------------------------
-/// Four lanes of a field of four units (gathered from units_, not packed: each unit is visited twice a step).
-template <class U, class Field>
-SCREE_AVX2 inline P4 gather4(U* const* u, Field f) {
-  return _mm256_set_pd(f(*u[3]), f(*u[2]), f(*u[1]), f(*u[0]));
-}
-SCREE_AVX2 inline P4 gather4(const Real* arr, const uint32_t* idx) {
-  return _mm256_set_pd(arr[idx[3]], arr[idx[2]], arr[idx[1]], arr[idx[0]]);
-}
-
-/// solveCentred<kFrozen> of four centred units whose 8 particles are distinct, each lane with its own frozen
-/// side (frozenB[j]: lane j is solveCentred<1>, else solveCentred<0>). The lanes do the scalar code's IEEE
-/// operations in its order: the free particle's gains kN = 1 / (im + eN), kT = 1 / ((im + rot) + eT) with
-/// im = ima + 0 = ima (inverse masses are >= +0, so adding the frozen side's zero changes no bit) and
-/// rot = (invI la) la; the frozen side's velocities are blended back unchanged (the scalar code never writes
-/// them). No rolling (left to the sweeps, as in the scalar shock pass).
-template <class U>
-SCREE_AVX2 __attribute__((noinline)) void solveShock4(U* const* u, const uint32_t* frozenB, Vec3* v, Vec3* w,
-                                                      const Real* invM, const Real* invI) {
-  alignas(16) uint32_t ia[4], ib[4];
-  for (int j = 0; j < 4; ++j) {
-    ia[j] = u[j]->a;
-    ib[j] = uint32_t(u[j]->b);
-  }
-  const P4 zero = _mm256_setzero_pd();
-  const P4 fB = _mm256_castsi256_pd(_mm256_set_epi64x(-int64_t(frozenB[3]), -int64_t(frozenB[2]),
-                                                       -int64_t(frozenB[1]), -int64_t(frozenB[0])));
-  P4 vax, vay, vaz, vbx, vby, vbz, wax, way, waz, wbx, wby, wbz;
-  load3(v, ia, vax, vay, vaz);
-  load3(v, ib, vbx, vby, vbz);
-  load3(w, ia, wax, way, waz);
-  load3(w, ib, wbx, wby, wbz);
-  const P4 ima = gather4(invM, ia), imb = gather4(invM, ib), iIa = gather4(invI, ia), iIb = gather4(invI, ib);
-  const P4 la = gather4(u, [](const U& x) { return x.la; }), lb = gather4(u, [](const U& x) { return x.lb; });
-  const P4 eN = gather4(u, [](const U& x) { return x.eN; }), eT = gather4(u, [](const U& x) { return x.eT; });
-  const P4 one = _mm256_set1_pd(1.0);
-  const P4 im = sel(imb, ima, fB);
-  const P4 rot = sel(mul(mul(iIb, lb), lb), mul(mul(iIa, la), la), fB);
-  const P4 kN = _mm256_div_pd(one, add(im, eN));
-  const P4 kT = _mm256_div_pd(one, add(add(im, rot), eT));
-  const P4 nx = gather4(u, [](const U& x) { return x.n.x(); }), ny = gather4(u, [](const U& x) { return x.n.y(); }),
-           nz = gather4(u, [](const U& x) { return x.n.z(); });
-  alignas(32) double out[4];
-  // Normal.
-  const P4 lN = gather4(u, [](const U& x) { return x.lN; });
-  const P4 vn = dot3(nx, ny, nz, sub(vax, vbx), sub(vay, vby), sub(vaz, vbz));
-  P4 nl = add(lN, mul(sub(sub(gather4(u, [](const U& x) { return x.rhsN; }), vn), mul(eN, lN)), kN));
-  const P4 lo = gather4(u, [](const U& x) { return x.loN; });
-  nl = sel(nl, lo, _mm256_cmp_pd(nl, lo, _CMP_LT_OQ));  // std::max(nl, lo)
-  _mm256_store_pd(out, nl);
-  for (int j = 0; j < 4; ++j) u[j]->lN = out[j];
-  {
-    const P4 d = sub(nl, lN);
-    const P4 moved = _mm256_cmp_pd(d, zero, _CMP_NEQ_UQ);
-    const P4 mA = _mm256_and_pd(moved, fB), mB = _mm256_andnot_pd(fB, moved);
-    const P4 px = mul(d, nx), py = mul(d, ny), pz = mul(d, nz);
-    vax = sel(vax, add(vax, mul(ima, px)), mA);
-    vay = sel(vay, add(vay, mul(ima, py)), mA);
-    vaz = sel(vaz, add(vaz, mul(ima, pz)), mA);
-    vbx = sel(vbx, sub(vbx, mul(imb, px)), mB);
-    vby = sel(vby, sub(vby, mul(imb, py)), mB);
-    vbz = sel(vbz, sub(vbz, mul(imb, pz)), mB);
-  }
-  // Friction (finite mu only: frictionLimit = mu max(lN, 0)).
-  {
-    const P4 mu = gather4(u, [](const U& x) { return x.mu; });
-    const P4 lim = mul(mu, sel(nl, zero, _mm256_cmp_pd(nl, zero, _CMP_LT_OQ)));
-    const P4 t1x = gather4(u, [](const U& x) { return x.t1.x(); }), t1y = gather4(u, [](const U& x) { return x.t1.y(); }),
-             t1z = gather4(u, [](const U& x) { return x.t1.z(); });
-    const P4 t2x = gather4(u, [](const U& x) { return x.t2.x(); }), t2y = gather4(u, [](const U& x) { return x.t2.y(); }),
-             t2z = gather4(u, [](const U& x) { return x.t2.z(); });
-    const P4 sigma = gather4(u, [](const U& x) { return x.sigma; });
-    const P4 lT1 = gather4(u, [](const U& x) { return x.lT1; }), lT2 = gather4(u, [](const U& x) { return x.lT2; });
-    const P4 dvx = sub(vax, vbx), dvy = sub(vay, vby), dvz = sub(vaz, vbz);
-    const P4 Lx = add(mul(la, wax), mul(lb, wbx)), Ly = add(mul(la, way), mul(lb, wby)),
-             Lz = add(mul(la, waz), mul(lb, wbz));
-    const P4 vt1 = sub(dot3(t1x, t1y, t1z, dvx, dvy, dvz), mul(sigma, dot3(Lx, Ly, Lz, t2x, t2y, t2z)));
-    const P4 vt2 = add(dot3(t2x, t2y, t2z, dvx, dvy, dvz), mul(sigma, dot3(Lx, Ly, Lz, t1x, t1y, t1z)));
-    const P4 rhsT1 = gather4(u, [](const U& x) { return x.rhsT1; }), rhsT2 = gather4(u, [](const U& x) { return x.rhsT2; });
-    P4 l1 = add(lT1, mul(sub(sub(rhsT1, vt1), mul(eT, lT1)), kT));
-    P4 l2 = add(lT2, mul(sub(sub(rhsT2, vt2), mul(eT, lT2)), kT));
-    projectDisc4(l1, l2, lim);
-    const P4 bounded = _mm256_cmp_pd(lim, zero, _CMP_NEQ_UQ);  // a zero bound leaves no friction
-    l1 = sel(zero, l1, bounded);
-    l2 = sel(zero, l2, bounded);
-    const P4 has = _mm256_cmp_pd(mu, zero, _CMP_GT_OQ);  // mu > 0, else no friction rows at all
-    l1 = sel(lT1, l1, has);
-    l2 = sel(lT2, l2, has);
-    _mm256_store_pd(out, l1);
-    for (int j = 0; j < 4; ++j) u[j]->lT1 = out[j];
-    _mm256_store_pd(out, l2);
-    for (int j = 0; j < 4; ++j) u[j]->lT2 = out[j];
-    const P4 d1 = sub(l1, lT1), d2 = sub(l2, lT2);
-    const P4 moved = _mm256_or_pd(_mm256_cmp_pd(d1, zero, _CMP_NEQ_UQ), _mm256_cmp_pd(d2, zero, _CMP_NEQ_UQ));
-    const P4 mA = _mm256_and_pd(moved, fB), mB = _mm256_andnot_pd(fB, moved);
-    const P4 px = add(mul(d1, t1x), mul(d2, t2x)), py = add(mul(d1, t1y), mul(d2, t2y)),
-             pz = add(mul(d1, t1z), mul(d2, t2z));
-    const P4 qx = mul(sigma, sub(mul(d1, t2x), mul(d2, t1x))), qy = mul(sigma, sub(mul(d1, t2y), mul(d2, t1y))),
-             qz = mul(sigma, sub(mul(d1, t2z), mul(d2, t1z)));  // n x P
-    const P4 iia = mul(iIa, la), iib = mul(iIb, lb);
-    vax = sel(vax, add(vax, mul(ima, px)), mA);
-    vay = sel(vay, add(vay, mul(ima, py)), mA);
-    vaz = sel(vaz, add(vaz, mul(ima, pz)), mA);
-    wax = sel(wax, sub(wax, mul(iia, qx)), mA);
-    way = sel(way, sub(way, mul(iia, qy)), mA);
-    waz = sel(waz, sub(waz, mul(iia, qz)), mA);
-    vbx = sel(vbx, sub(vbx, mul(imb, px)), mB);
-    vby = sel(vby, sub(vby, mul(imb, py)), mB);
-    vbz = sel(vbz, sub(vbz, mul(imb, pz)), mB);
-    wbx = sel(wbx, sub(wbx, mul(iib, qx)), mB);
-    wby = sel(wby, sub(wby, mul(iib, qy)), mB);
-    wbz = sel(wbz, sub(wbz, mul(iib, qz)), mB);
-  }
-  store3(v, ia, vax, vay, vaz);
-  store3(v, ib, vbx, vby, vbz);
-  store3(w, ia, wax, way, waz);
-  store3(w, ib, wbx, wby, wbz);
-}
-
 bool cpuHasAvx2() {
   static const bool has = __builtin_cpu_supports("avx2");
   return has;
@@ -466,8 +346,6 @@ bool cpuHasAvx2() {
 bool cpuHasAvx2() { return false; }
 template <int kN>
 Real solvePacketsAvx2(GranularStage::Packet*, Vec3*, Vec3*) { return 0; }
-template <class U>
-void solveShock4(U* const*, const uint32_t*, Vec3*, Vec3*, const Real*, const Real*) {}
 #endif
 
 }  // namespace
@@ -802,8 +680,7 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
       u.lR1 = sgn * ce->rolling.dot(u.t1);
       u.lR2 = sgn * ce->rolling.dot(u.t2);
     }
-    // bit 0: a four-wide sweep packet may hold it; bit 1: a four-wide shock group may (see shockPass).
-    schedUnit_[dest].packable = uint32_t(packable(u)) | uint32_t(u.centred && u.b >= 0 && std::isfinite(u.mu)) << 1;
+    schedUnit_[dest].packable = packable(u);
   }
 }
 
@@ -1136,8 +1013,6 @@ void GranularStage::setVectorSweepEnabled(bool on) { gVectorSweepEnabled = on; }
 
 uint64_t GranularStage::packedUnitsTotal() { return gPackedUnits.load(); }
 
-uint64_t GranularStage::shockPackedUnitsTotal() { return gShockPackedUnits.load(); }
-
 bool GranularStage::packable(const Unit& u) {
   // +0 friction targets (no surface velocity) and equal tangent gains: the packet's reduced fields.
   const bool plainT = std::bit_cast<uint64_t>(u.rhsT1) == 0 && std::bit_cast<uint64_t>(u.rhsT2) == 0;
@@ -1177,7 +1052,7 @@ void GranularStage::buildSchedule(const GranularBodySystem& ps) {
       uint32_t L = levelAt(u.a);
       if (u.b >= 0) L = std::max(L, levelAt(size_t(u.b)));
       ++L;
-      packable_[k - b0] = char(u.packable & 1u);
+      packable_[k - b0] = char(u.packable);
       levelOf_[k - b0] = L;
       top = std::max(top, L);
       lastLevel_[u.a] = L;
@@ -1321,125 +1196,25 @@ void GranularStage::shockPass(GranularBodySystem& ps, std::vector<SolverBodyStat
   auto& v = ps.velocities();
   auto& w = ps.angularVelocities();
   Real unused = 0;
-  auto solveOne = [&](uint32_t code) SCREE_UNIT_INLINE {
-    Unit& u = units_[code >> 1];
-    if (u.centred) {
-      if (code & 1) solveCentred<1>(u, v.data(), w.data(), ps.invMasses().data(), invInertia_.data(), unused);
-      else solveCentred<0>(u, v.data(), w.data(), ps.invMasses().data(), invInertia_.data(), unused);
-    } else if (code & 1) solveUnit<1>(u, v, w, ps.invMasses(), invInertia_, bodies, unused);
-    else solveUnit<0>(u, v, w, ps.invMasses(), invInertia_, bodies, unused);
-  };
-  auto fetchUnit = [&](uint32_t code) SCREE_UNIT_INLINE {
-    const char* p = reinterpret_cast<const char*>(&units_[code >> 1]);
-    for (size_t off = 0; off < sizeof(Unit); off += 64) __builtin_prefetch(p + off, 1);
-    __builtin_prefetch(p + sizeof(Unit) - 1, 1);
-  };
-  const size_t nOrder = shockOrder_.size();
-  if (gVectorSweepEnabled && cpuHasAvx2()) {
-    // Four-wide shock pass (see buildShockSchedule): the visits in dependency-level order, groups of four
-    // centred units solved by solveShock4; the result is the scalar pass's bit for bit.
-    buildShockSchedule(ps);
-    const size_t nItems = shockItems_.size();
-    constexpr size_t kAheadItems = 2;
-    auto fetch = [&](int32_t it) SCREE_UNIT_INLINE {
-      if (it >= 0) return fetchUnit(uint32_t(it));
-      const uint32_t* g = &shockGroups_[size_t(-1 - it) * 4];
-      for (int j = 0; j < 4; ++j) fetchUnit(g[j]);
-    };
-    for (int s = 0; s < sweeps; ++s)
-      for (size_t i = 0; i < nItems; ++i) {
-        if (i + kAheadItems < nItems) fetch(shockItems_[i + kAheadItems]);
-        const int32_t it = shockItems_[i];
-        if (it >= 0) {
-          solveOne(uint32_t(it));
-          continue;
-        }
-        const uint32_t* g = &shockGroups_[size_t(-1 - it) * 4];
-        Unit* u4[4];
-        uint32_t frozenB[4];
-        for (int j = 0; j < 4; ++j) {
-          u4[j] = &units_[g[j] >> 1];
-          frozenB[j] = g[j] & 1;
-        }
-        solveShock4(u4, frozenB, v.data(), w.data(), ps.invMasses().data(), invInertia_.data());
-      }
-    return;
-  }
   // The units are visited in height order, i.e. scattered over units_ (8 MB in the trench bench, beyond the
   // L2 cache): the unit a few visits ahead is prefetched (no effect on results).
   constexpr size_t kAhead = 8;
+  const size_t nOrder = shockOrder_.size();
   for (int s = 0; s < sweeps; ++s)
     for (size_t i = 0; i < nOrder; ++i) {
-      if (i + kAhead < nOrder) fetchUnit(shockOrder_[i + kAhead].second);
-      solveOne(shockOrder_[i].second);
-    }
-}
-
-void GranularStage::buildShockSchedule(const GranularBodySystem& ps) {
-  // Each visit of shockOrder_ gets a dependency level: one more than the highest level of the earlier visits
-  // that touch one of its particles (a frozen side is read, so it counts). The visits are then taken level by
-  // level (a stable counting sort): visits of one level touch disjoint particles and commute exactly, and two
-  // visits sharing a particle keep their order, so the pass computes the height order's result bit for bit
-  // (the argument of the four-wide sweep, with height order in place of unit order). Within a level, centred
-  // particle pairs of finite friction go four at a time into shockGroups_ (solveShock4), the rest stay single.
-  // Geometry visits touch only their particle: the shock pass skips geometry of dynamic bodies, and static or
-  // kinematic bodies are never written here.
-  const size_t n = ps.size();
-  const size_t nOrder = shockOrder_.size();
-  shockItems_.clear();
-  shockGroups_.clear();
-  if (lastLevel_.size() < n) {
-    lastLevel_.resize(n);
-    stampOf_.assign(n, 0);
-    stamp_ = 0;
-  }
-  if (++stamp_ == 0) {  // wrapped: forget all stamps
-    std::fill(stampOf_.begin(), stampOf_.end(), 0);
-    stamp_ = 1;
-  }
-  // levelOf_, levelCount_ and levelOrder_ are buildSchedule's scratch buffers, reused (it is done with them).
-  levelOf_.resize(nOrder);
-  uint32_t top = 0;
-  auto levelAt = [&](size_t i) { return stampOf_[i] == stamp_ ? lastLevel_[i] : 0u; };
-  for (size_t i = 0; i < nOrder; ++i) {
-    const SchedUnit& u = schedUnit_[shockOrder_[i].second >> 1];
-    uint32_t L = levelAt(u.a);
-    if (u.b >= 0) L = std::max(L, levelAt(size_t(u.b)));
-    ++L;
-    levelOf_[i] = L;
-    top = std::max(top, L);
-    lastLevel_[u.a] = L;
-    stampOf_[u.a] = stamp_;
-    if (u.b >= 0) {
-      lastLevel_[size_t(u.b)] = L;
-      stampOf_[size_t(u.b)] = stamp_;
-    }
-  }
-  levelCount_.assign(size_t(top) + 2, 0);
-  for (size_t i = 0; i < nOrder; ++i) ++levelCount_[levelOf_[i] + 1];
-  for (uint32_t L = 0; L <= top; ++L) levelCount_[L + 1] += levelCount_[L];
-  levelOrder_.resize(nOrder);
-  for (size_t i = 0; i < nOrder; ++i) levelOrder_[levelCount_[levelOf_[i]]++] = uint32_t(i);
-  size_t pos = 0;
-  uint32_t group[4];
-  for (uint32_t L = 1; L <= top; ++L) {
-    int grouped = 0;
-    for (const size_t end = levelCount_[L]; pos < end; ++pos) {
-      const uint32_t code = shockOrder_[levelOrder_[pos]].second;
-      if (!(schedUnit_[code >> 1].packable & 2u)) {
-        shockItems_.push_back(int32_t(code));
-        continue;
+      if (i + kAhead < nOrder) {
+        const char* p = reinterpret_cast<const char*>(&units_[shockOrder_[i + kAhead].second >> 1]);
+        for (size_t off = 0; off < sizeof(Unit); off += 64) __builtin_prefetch(p + off, 1);
+        __builtin_prefetch(p + sizeof(Unit) - 1, 1);
       }
-      group[grouped++] = code;
-      if (grouped == 4) {
-        shockItems_.push_back(-1 - int32_t(shockGroups_.size() / 4));
-        shockGroups_.insert(shockGroups_.end(), group, group + 4);
-        grouped = 0;
-      }
+      const uint32_t code = shockOrder_[i].second;
+      Unit& u = units_[code >> 1];
+      if (u.centred) {
+        if (code & 1) solveCentred<1>(u, v.data(), w.data(), ps.invMasses().data(), invInertia_.data(), unused);
+        else solveCentred<0>(u, v.data(), w.data(), ps.invMasses().data(), invInertia_.data(), unused);
+      } else if (code & 1) solveUnit<1>(u, v, w, ps.invMasses(), invInertia_, bodies, unused);
+      else solveUnit<0>(u, v, w, ps.invMasses(), invInertia_, bodies, unused);
     }
-    for (int j = 0; j < grouped; ++j) shockItems_.push_back(int32_t(group[j]));
-  }
-  gShockPackedUnits += shockGroups_.size();
 }
 
 void GranularStage::appendDirectRows(const GranularBodySystem& ps, std::vector<ConstraintRow>& rows,

@@ -173,9 +173,6 @@ class GranularStage {
   /// Units put into packets since the process started, over all stages (a test's evidence that the four-wide
   /// path ran).
   static uint64_t packedUnitsTotal();
-  /// Shock-pass visits solved in four-wide groups since the process started, per sweep of the pass counted once
-  /// (the four-wide shock pass of the .cpp's buildShockSchedule; same switch as the sweep).
-  static uint64_t shockPackedUnitsTotal();
 
  private:
   // One contact point between particle a and particle b or a geometry (its rigid body index `body`, -1 none).
@@ -322,19 +319,13 @@ class GranularStage {
   struct SchedUnit {
     uint32_t a = 0;
     int32_t b = -1;
-    uint32_t packable = 0;  // bit 0: may go into a sweep packet; bit 1: into a four-wide shock group
+    uint32_t packable = 0;
   };
   std::vector<SchedUnit> schedUnit_;
   static bool packable(const Unit& u);  // may go into a packet (see the .cpp)
   void buildSchedule(const GranularBodySystem& ps);
   void pack(const GranularBodySystem& ps);  // unit data (and impulses) into packets_
   void unpack();                            // packets' impulses back into units_
-  // ---- Four-wide shock pass (issue 16, trench speed, seventh round; the .cpp's buildShockSchedule) -----------
-  // The shock pass's visits in dependency-level order: >= 0 a single visit (unit * 2 + frozen side, as in
-  // shockOrder_), < 0 the group -1 - item of shockGroups_ (four visits of centred units, solved by one call).
-  std::vector<int32_t> shockItems_;
-  std::vector<uint32_t> shockGroups_;
-  void buildShockSchedule(const GranularBodySystem& ps);
 };
 
 }  // namespace scree::detail
