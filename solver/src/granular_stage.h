@@ -173,6 +173,13 @@ class GranularStage {
   /// Units put into packets since the process started, over all stages (a test's evidence that the four-wide
   /// path ran).
   static uint64_t packedUnitsTotal();
+  /// Whether the sweep solves pairs of packets in the eight lanes of AVX-512 registers (the .cpp's "Eight-wide
+  /// sweep"; needs vectorSweepAvailable()); bit-identical to the four-wide and the scalar sweep.
+  static bool avx512SweepAvailable();
+  /// Test and measurement switch: false keeps the four-wide kernel on an AVX-512 CPU. Default true.
+  static void setAvx512SweepEnabled(bool on);
+  /// Unit visits solved by the eight-wide kernel since the process started (a test's evidence that it ran).
+  static uint64_t wideUnitsTotal();
 
  private:
   // One contact point between particle a and particle b or a geometry (its rigid body index `body`, -1 none).
@@ -246,6 +253,7 @@ class GranularStage {
     bool direct = false;  // the contact material's solve type is not ITERATIVE (DIRECT mode)
   };
   std::vector<UnitPlan> plan_;
+  std::vector<const CacheEntry*> warm_;  // [pp + pg contacts] the warm-start entry of each contact, or null
   std::vector<uint32_t> unitDest_;
   std::vector<uint16_t> slabOf_;
   std::vector<uint32_t> slabCount_, slabCursor_;
