@@ -33,7 +33,9 @@
 //                Four-wide sweep (where the CPU has AVX2): each slab's units are swept in dependency-level order
 //                and centred units of one level, which share no particle, four at a time in SIMD lanes; the
 //                result is the scalar sweep's bit for bit (the .cpp's "Four-wide sweep" says why; memory, not
-//                arithmetic, bounds it, so the packets are prefetched).
+//                arithmetic, bounds it, so the packets are prefetched). Where the CPU has AVX-512, two packets of
+//                a level are solved at once in the eight lanes of 512-bit registers (the .cpp's "Eight-wide
+//                sweep"), again bit for bit.
 //   integrate    x += h v for live particles; a particle whose velocity or position turns non-finite is
 //                reported by id, keeps its last position and is stopped. Clusters joined by glued DIRECT bonds
 //                move by their exactly integrated rigid motion first (integrateBondedLumps, below).
