@@ -188,14 +188,26 @@ SCREE_AVX2 inline void projectDisc4(P4& l1, P4& l2, P4 lim) {
   l2 = sel(l2, mul(l2, s), over);
 }
 
-/// The state of one packet in the kernel: its particles' velocities and what the later updates need.
+/// The state of one packet in the kernel: its particles' velocities, inverse masses and inertias (read from the
+/// particle arrays by index, not stored in the packet: 128 fewer bytes per packet to stream), and what the
+/// later updates need.
 struct LaneState {
   P4 vax, vay, vaz, vbx, vby, vbz, wax, way, waz, wbx, wby, wbz;
+  P4 ima, imb, iIa, iIb;  // the particles' inverse masses and inertias (read from the particle arrays)
   P4 lNpos;  // max(lambda_n, 0) after the normal update
   P4 absD;   // |delta lambda_n|
 };
 
-SCREE_AVX2 inline void stageLoad(const GranularStage::Packet& p, const Vec3* v, const Vec3* w, LaneState& s) {
+SCREE_AVX2 inline P4 gather4(const Real* arr, const uint32_t* idx) {
+  return _mm256_set_pd(arr[idx[3]], arr[idx[2]], arr[idx[1]], arr[idx[0]]);
+}
+
+SCREE_AVX2 inline void stageLoad(const GranularStage::Packet& p, const Vec3* v, const Vec3* w, const Real* invM,
+                                 const Real* invI, LaneState& s) {
+  s.ima = gather4(invM, p.a);
+  s.imb = gather4(invM, p.b);
+  s.iIa = gather4(invI, p.a);
+  s.iIb = gather4(invI, p.b);
   load3(v, p.a, s.vax, s.vay, s.vaz);
   load3(v, p.b, s.vbx, s.vby, s.vbz);
   load3(w, p.a, s.wax, s.way, s.waz);
@@ -215,7 +227,7 @@ SCREE_AVX2 inline void stageNormal(GranularStage::Packet& p, LaneState& s) {
   auto F = [&](int k) SCREE_AVX2 { return _mm256_load_pd(p.f[k]); };
   const P4 zero = _mm256_setzero_pd();
   const P4 nx = F(G::kNx), ny = F(G::kNy), nz = F(G::kNz);
-  const P4 ima = F(G::kImA), imb = F(G::kImB);
+  const P4 ima = s.ima, imb = s.imb;
   const P4 lN = F(G::kLN);
   const P4 vn = dot3(nx, ny, nz, sub(s.vax, s.vbx), sub(s.vay, s.vby), sub(s.vaz, s.vbz));
   P4 nl = add(lN, mul(sub(sub(F(G::kRhsN), vn), mul(F(G::kEN), lN)), F(G::kKN)));
@@ -270,8 +282,8 @@ SCREE_AVX2 inline void stageFriction(GranularStage::Packet& p, LaneState& s) {
            pz = add(mul(d1, t1z), mul(d2, t2z));
   const P4 qx = mul(sigma, sub(mul(d1, t2x), mul(d2, t1x))), qy = mul(sigma, sub(mul(d1, t2y), mul(d2, t1y))),
            qz = mul(sigma, sub(mul(d1, t2z), mul(d2, t1z)));  // n x P
-  const P4 ima = F(G::kImA), imb = F(G::kImB);
-  const P4 iia = mul(F(G::kInvIA), la), iib = mul(F(G::kInvIB), lb);  // as solveCentred's
+  const P4 ima = s.ima, imb = s.imb;
+  const P4 iia = mul(s.iIa, la), iib = mul(s.iIb, lb);  // as solveCentred's
   s.vax = sel(s.vax, add(s.vax, mul(ima, px)), moved);
   s.vay = sel(s.vay, add(s.vay, mul(ima, py)), moved);
   s.vaz = sel(s.vaz, add(s.vaz, mul(ima, pz)), moved);
@@ -313,7 +325,7 @@ SCREE_AVX2 inline void stageRolling(GranularStage::Packet& p, LaneState& s) {
            tz = add(mul(c1, t1z), mul(c2, t2z));
   _mm256_store_pd(p.f[G::kLR1], sel(lR1, l1, has));
   _mm256_store_pd(p.f[G::kLR2], sel(lR2, l2, has));
-  const P4 iA = F(G::kInvIA), iB = F(G::kInvIB);
+  const P4 iA = s.iIa, iB = s.iIb;
   s.wax = sel(s.wax, add(s.wax, mul(iA, tx)), has);
   s.way = sel(s.way, add(s.way, mul(iA, ty)), has);
   s.waz = sel(s.waz, add(s.waz, mul(iA, tz)), has);
@@ -326,9 +338,10 @@ SCREE_AVX2 inline void stageRolling(GranularStage::Packet& p, LaneState& s) {
 /// for every packet before the next stage, so the packets' independent dependency chains (square root and
 /// division in each disc projection) overlap in the core. Returns the largest |delta lambda_n|.
 template <int kN>
-SCREE_AVX2 __attribute__((noinline)) Real solvePacketsAvx2(GranularStage::Packet* p, Vec3* v, Vec3* w) {
+SCREE_AVX2 __attribute__((noinline)) Real solvePacketsAvx2(GranularStage::Packet* p, Vec3* v, Vec3* w,
+                                                          const Real* invM, const Real* invI) {
   LaneState s[kN];
-  for (int q = 0; q < kN; ++q) stageLoad(p[q], v, w, s[q]);
+  for (int q = 0; q < kN; ++q) stageLoad(p[q], v, w, invM, invI, s[q]);
   for (int q = 0; q < kN; ++q) stageNormal(p[q], s[q]);
   for (int q = 0; q < kN; ++q) stageFriction(p[q], s[q]);
   for (int q = 0; q < kN; ++q) stageRolling(p[q], s[q]);
@@ -400,10 +413,16 @@ SCREE_AVX512 inline void store3x8(Vec3* arr, const uint32_t* idx0, const uint32_
 
 struct LaneState8 {
   P8 vax, vay, vaz, vbx, vby, vbz, wax, way, waz, wbx, wby, wbz;
+  P8 ima, imb, iIa, iIb;
   P8 lNpos, absD;
 };
 
-SCREE_AVX512 inline void stageLoad8(const GranularStage::Packet* p, const Vec3* v, const Vec3* w, LaneState8& s) {
+SCREE_AVX512 inline void stageLoad8(const GranularStage::Packet* p, const Vec3* v, const Vec3* w, const Real* invM,
+                                    const Real* invI, LaneState8& s) {
+  s.ima = join8(gather4(invM, p[0].a), gather4(invM, p[1].a));
+  s.imb = join8(gather4(invM, p[0].b), gather4(invM, p[1].b));
+  s.iIa = join8(gather4(invI, p[0].a), gather4(invI, p[1].a));
+  s.iIb = join8(gather4(invI, p[0].b), gather4(invI, p[1].b));
   load3x8(v, p[0].a, p[1].a, s.vax, s.vay, s.vaz);
   load3x8(v, p[0].b, p[1].b, s.vbx, s.vby, s.vbz);
   load3x8(w, p[0].a, p[1].a, s.wax, s.way, s.waz);
@@ -422,7 +441,7 @@ SCREE_AVX512 inline void stageNormal8(GranularStage::Packet* p, LaneState8& s) {
   using G = GranularStage;
   const P8 zero = _mm512_setzero_pd();
   const P8 nx = field8(p, G::kNx), ny = field8(p, G::kNy), nz = field8(p, G::kNz);
-  const P8 ima = field8(p, G::kImA), imb = field8(p, G::kImB);
+  const P8 ima = s.ima, imb = s.imb;
   const P8 lN = field8(p, G::kLN);
   const P8 vn = dot8(nx, ny, nz, sub8(s.vax, s.vbx), sub8(s.vay, s.vby), sub8(s.vaz, s.vbz));
   P8 nl = add8(lN, mul8(sub8(sub8(field8(p, G::kRhsN), vn), mul8(field8(p, G::kEN), lN)), field8(p, G::kKN)));
@@ -476,8 +495,8 @@ SCREE_AVX512 inline void stageFriction8(GranularStage::Packet* p, LaneState8& s)
            pz = add8(mul8(d1, t1z), mul8(d2, t2z));
   const P8 qx = mul8(sigma, sub8(mul8(d1, t2x), mul8(d2, t1x))), qy = mul8(sigma, sub8(mul8(d1, t2y), mul8(d2, t1y))),
            qz = mul8(sigma, sub8(mul8(d1, t2z), mul8(d2, t1z)));  // n x P
-  const P8 ima = field8(p, G::kImA), imb = field8(p, G::kImB);
-  const P8 iia = mul8(field8(p, G::kInvIA), la), iib = mul8(field8(p, G::kInvIB), lb);
+  const P8 ima = s.ima, imb = s.imb;
+  const P8 iia = mul8(s.iIa, la), iib = mul8(s.iIb, lb);
   s.vax = sel8(s.vax, add8(s.vax, mul8(ima, px)), moved);
   s.vay = sel8(s.vay, add8(s.vay, mul8(ima, py)), moved);
   s.vaz = sel8(s.vaz, add8(s.vaz, mul8(ima, pz)), moved);
@@ -517,7 +536,7 @@ SCREE_AVX512 inline void stageRolling8(GranularStage::Packet* p, LaneState8& s) 
            tz = add8(mul8(c1, t1z), mul8(c2, t2z));
   storeField8(p, G::kLR1, sel8(lR1, l1, has));
   storeField8(p, G::kLR2, sel8(lR2, l2, has));
-  const P8 iA = field8(p, G::kInvIA), iB = field8(p, G::kInvIB);
+  const P8 iA = s.iIa, iB = s.iIb;
   s.wax = sel8(s.wax, add8(s.wax, mul8(iA, tx)), has);
   s.way = sel8(s.way, add8(s.way, mul8(iA, ty)), has);
   s.waz = sel8(s.waz, add8(s.waz, mul8(iA, tz)), has);
@@ -529,9 +548,10 @@ SCREE_AVX512 inline void stageRolling8(GranularStage::Packet* p, LaneState8& s) 
 /// solvePacketsAvx2<2 kZ> in eight lanes: kZ pairs of packets (2 kZ packets of one level). Returns the largest
 /// |delta lambda_n|, folded in the four-wide kernel's order.
 template <int kZ>
-SCREE_AVX512 __attribute__((noinline)) Real solvePacketsAvx512(GranularStage::Packet* p, Vec3* v, Vec3* w) {
+SCREE_AVX512 __attribute__((noinline)) Real solvePacketsAvx512(GranularStage::Packet* p, Vec3* v, Vec3* w,
+                                                              const Real* invM, const Real* invI) {
   LaneState8 s[kZ];
-  for (int q = 0; q < kZ; ++q) stageLoad8(p + 2 * q, v, w, s[q]);
+  for (int q = 0; q < kZ; ++q) stageLoad8(p + 2 * q, v, w, invM, invI, s[q]);
   for (int q = 0; q < kZ; ++q) stageNormal8(p + 2 * q, s[q]);
   for (int q = 0; q < kZ; ++q) stageFriction8(p + 2 * q, s[q]);
   for (int q = 0; q < kZ; ++q) stageRolling8(p + 2 * q, s[q]);
@@ -559,10 +579,10 @@ bool cpuHasAvx2() {
 #else
 bool cpuHasAvx2() { return false; }
 template <int kN>
-Real solvePacketsAvx2(GranularStage::Packet*, Vec3*, Vec3*) { return 0; }
+Real solvePacketsAvx2(GranularStage::Packet*, Vec3*, Vec3*, const Real*, const Real*) { return 0; }
 bool cpuHasAvx512() { return false; }
 template <int kZ>
-Real solvePacketsAvx512(GranularStage::Packet*, Vec3*, Vec3*) { return 0; }
+Real solvePacketsAvx512(GranularStage::Packet*, Vec3*, Vec3*, const Real*, const Real*) { return 0; }
 #endif
 
 }  // namespace
@@ -1174,6 +1194,8 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
     if (!vec) return runRange(slabStart_[size_t(sl)], slabStart_[size_t(sl) + 1]);
     Real md = 0;
     uint64_t wideUnits = 0;
+    const Real* im = invM.data();
+    const Real* ii = invInertia_.data();
     const uint32_t i0 = itemStart_[size_t(sl)], i1 = itemStart_[size_t(sl) + 1];
     auto item = [&](int32_t it) SCREE_UNIT_INLINE {
       if (it >= 0) one(units_[size_t(it)], md);
@@ -1183,21 +1205,21 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
         if (wide) {  // eight-wide: pairs of packets in 512-bit lanes, a last odd packet four-wide
           wideUnits += (code & 3) >= 1 ? ((code & 3) == 3 ? 16 : 8) : 0;
           switch (code & 3) {
-            case 0: md = std::max(md, solvePacketsAvx2<1>(p, v.data(), w.data())); break;
-            case 1: md = std::max(md, solvePacketsAvx512<1>(p, v.data(), w.data())); break;
+            case 0: md = std::max(md, solvePacketsAvx2<1>(p, v.data(), w.data(), im, ii)); break;
+            case 1: md = std::max(md, solvePacketsAvx512<1>(p, v.data(), w.data(), im, ii)); break;
             case 2:
-              md = std::max(md, solvePacketsAvx512<1>(p, v.data(), w.data()));
-              md = std::max(md, solvePacketsAvx2<1>(p + 2, v.data(), w.data()));
+              md = std::max(md, solvePacketsAvx512<1>(p, v.data(), w.data(), im, ii));
+              md = std::max(md, solvePacketsAvx2<1>(p + 2, v.data(), w.data(), im, ii));
               break;
-            default: md = std::max(md, solvePacketsAvx512<2>(p, v.data(), w.data())); break;
+            default: md = std::max(md, solvePacketsAvx512<2>(p, v.data(), w.data(), im, ii)); break;
           }
           return;
         }
         switch (code & 3) {
-          case 0: md = std::max(md, solvePacketsAvx2<1>(p, v.data(), w.data())); break;
-          case 1: md = std::max(md, solvePacketsAvx2<2>(p, v.data(), w.data())); break;
-          case 2: md = std::max(md, solvePacketsAvx2<3>(p, v.data(), w.data())); break;
-          default: md = std::max(md, solvePacketsAvx2<4>(p, v.data(), w.data())); break;
+          case 0: md = std::max(md, solvePacketsAvx2<1>(p, v.data(), w.data(), im, ii)); break;
+          case 1: md = std::max(md, solvePacketsAvx2<2>(p, v.data(), w.data(), im, ii)); break;
+          case 2: md = std::max(md, solvePacketsAvx2<3>(p, v.data(), w.data(), im, ii)); break;
+          default: md = std::max(md, solvePacketsAvx2<4>(p, v.data(), w.data(), im, ii)); break;
         }
       }
     };
@@ -1352,8 +1374,7 @@ void GranularStage::buildSchedule(const GranularBodySystem& ps) {
   gPackedUnits += 4 * numPackets_;
 }
 
-void GranularStage::pack(const GranularBodySystem& ps) {
-  const auto& invM = ps.invMasses();
+void GranularStage::pack(const GranularBodySystem&) {
   // The units are read in level order, scattered over units_: the next packet's are fetched ahead.
   constexpr size_t kAhead = 2;
   for (size_t q = 0; q < numPackets_; ++q) {
@@ -1391,10 +1412,6 @@ void GranularStage::pack(const GranularBodySystem& ps) {
       f[kMu][j] = u.mu;
       f[kRollMu][j] = u.rollMu;
       f[kKR][j] = u.kR;
-      f[kImA][j] = invM[a];
-      f[kImB][j] = invM[b];
-      f[kInvIA][j] = invInertia_[a];
-      f[kInvIB][j] = invInertia_[b];
       f[kLN][j] = u.lN;
       f[kLT1][j] = u.lT1;
       f[kLT2][j] = u.lT2;

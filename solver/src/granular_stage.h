@@ -302,11 +302,11 @@ class GranularStage {
  public:
   // Four centred units with 8 distinct particles, lane-interleaved (field f of lane j at f[f][j]): the unit data
   // the sweep reads (a centred unit's two tangent gains are equal: one kKT; packed units have no surface
-  // velocity, so the friction targets are zero), the particles' inverse masses and inertias, and the impulses (the authoritative copy while
+  // velocity, so the friction targets are zero), and the impulses (the authoritative copy while
   // packed_, written back to the units by unpack()).
   enum PacketField : int {
     kNx, kNy, kNz, kT1x, kT1y, kT1z, kT2x, kT2y, kT2z, kSigma, kLa, kLb, kKN, kKT, kRhsN, kEN, kLoN, kET, kMu,
-    kRollMu, kKR, kImA, kImB, kInvIA, kInvIB, kLN, kLT1, kLT2, kLR1, kLR2, kNumPacketFields
+    kRollMu, kKR, kLN, kLT1, kLT2, kLR1, kLR2, kNumPacketFields
   };
   struct alignas(32) Packet {
     uint32_t a[4], b[4];  // first: the kernel reads them first (then the particles' velocities)
