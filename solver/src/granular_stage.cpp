@@ -127,6 +127,8 @@ void radixSortBy(std::vector<T>& v, std::vector<T>& tmp, int bits, KeyOf digitKe
 // units. The kernel is chosen at run time (__builtin_cpu_supports), so the build runs on any x86-64; elsewhere,
 // or without AVX2, the scalar sweep runs in unit order. test_unit_granular_system compares both bit for bit.
 bool gVectorSweepEnabled = true;
+bool gWideSweepEnabled = true;  // setAvx512SweepEnabled
+std::atomic<uint64_t> gWideUnits{0};  // wideUnitsTotal
 std::atomic<uint64_t> gPackedUnits{0};  // packedUnitsTotal
 // Packets per kernel call (1-4): independent packets of one level solved together overlap their latencies.
 constexpr size_t kPacketRun = SCREE_PACKET_RUN;
@@ -186,14 +188,26 @@ SCREE_AVX2 inline void projectDisc4(P4& l1, P4& l2, P4 lim) {
   l2 = sel(l2, mul(l2, s), over);
 }
 
-/// The state of one packet in the kernel: its particles' velocities and what the later updates need.
+/// The state of one packet in the kernel: its particles' velocities, inverse masses and inertias (read from the
+/// particle arrays by index, not stored in the packet: 128 fewer bytes per packet to stream), and what the
+/// later updates need.
 struct LaneState {
   P4 vax, vay, vaz, vbx, vby, vbz, wax, way, waz, wbx, wby, wbz;
+  P4 ima, imb, iIa, iIb;  // the particles' inverse masses and inertias (read from the particle arrays)
   P4 lNpos;  // max(lambda_n, 0) after the normal update
   P4 absD;   // |delta lambda_n|
 };
 
-SCREE_AVX2 inline void stageLoad(const GranularStage::Packet& p, const Vec3* v, const Vec3* w, LaneState& s) {
+SCREE_AVX2 inline P4 gather4(const Real* arr, const uint32_t* idx) {
+  return _mm256_set_pd(arr[idx[3]], arr[idx[2]], arr[idx[1]], arr[idx[0]]);
+}
+
+SCREE_AVX2 inline void stageLoad(const GranularStage::Packet& p, const Vec3* v, const Vec3* w, const Real* invM,
+                                 const Real* invI, LaneState& s) {
+  s.ima = gather4(invM, p.a);
+  s.imb = gather4(invM, p.b);
+  s.iIa = gather4(invI, p.a);
+  s.iIb = gather4(invI, p.b);
   load3(v, p.a, s.vax, s.vay, s.vaz);
   load3(v, p.b, s.vbx, s.vby, s.vbz);
   load3(w, p.a, s.wax, s.way, s.waz);
@@ -213,7 +227,7 @@ SCREE_AVX2 inline void stageNormal(GranularStage::Packet& p, LaneState& s) {
   auto F = [&](int k) SCREE_AVX2 { return _mm256_load_pd(p.f[k]); };
   const P4 zero = _mm256_setzero_pd();
   const P4 nx = F(G::kNx), ny = F(G::kNy), nz = F(G::kNz);
-  const P4 ima = F(G::kImA), imb = F(G::kImB);
+  const P4 ima = s.ima, imb = s.imb;
   const P4 lN = F(G::kLN);
   const P4 vn = dot3(nx, ny, nz, sub(s.vax, s.vbx), sub(s.vay, s.vby), sub(s.vaz, s.vbz));
   P4 nl = add(lN, mul(sub(sub(F(G::kRhsN), vn), mul(F(G::kEN), lN)), F(G::kKN)));
@@ -268,8 +282,8 @@ SCREE_AVX2 inline void stageFriction(GranularStage::Packet& p, LaneState& s) {
            pz = add(mul(d1, t1z), mul(d2, t2z));
   const P4 qx = mul(sigma, sub(mul(d1, t2x), mul(d2, t1x))), qy = mul(sigma, sub(mul(d1, t2y), mul(d2, t1y))),
            qz = mul(sigma, sub(mul(d1, t2z), mul(d2, t1z)));  // n x P
-  const P4 ima = F(G::kImA), imb = F(G::kImB);
-  const P4 iia = mul(F(G::kInvIA), la), iib = mul(F(G::kInvIB), lb);  // as solveCentred's
+  const P4 ima = s.ima, imb = s.imb;
+  const P4 iia = mul(s.iIa, la), iib = mul(s.iIb, lb);  // as solveCentred's
   s.vax = sel(s.vax, add(s.vax, mul(ima, px)), moved);
   s.vay = sel(s.vay, add(s.vay, mul(ima, py)), moved);
   s.vaz = sel(s.vaz, add(s.vaz, mul(ima, pz)), moved);
@@ -311,7 +325,7 @@ SCREE_AVX2 inline void stageRolling(GranularStage::Packet& p, LaneState& s) {
            tz = add(mul(c1, t1z), mul(c2, t2z));
   _mm256_store_pd(p.f[G::kLR1], sel(lR1, l1, has));
   _mm256_store_pd(p.f[G::kLR2], sel(lR2, l2, has));
-  const P4 iA = F(G::kInvIA), iB = F(G::kInvIB);
+  const P4 iA = s.iIa, iB = s.iIb;
   s.wax = sel(s.wax, add(s.wax, mul(iA, tx)), has);
   s.way = sel(s.way, add(s.way, mul(iA, ty)), has);
   s.waz = sel(s.waz, add(s.waz, mul(iA, tz)), has);
@@ -324,9 +338,10 @@ SCREE_AVX2 inline void stageRolling(GranularStage::Packet& p, LaneState& s) {
 /// for every packet before the next stage, so the packets' independent dependency chains (square root and
 /// division in each disc projection) overlap in the core. Returns the largest |delta lambda_n|.
 template <int kN>
-SCREE_AVX2 __attribute__((noinline)) Real solvePacketsAvx2(GranularStage::Packet* p, Vec3* v, Vec3* w) {
+SCREE_AVX2 __attribute__((noinline)) Real solvePacketsAvx2(GranularStage::Packet* p, Vec3* v, Vec3* w,
+                                                          const Real* invM, const Real* invI) {
   LaneState s[kN];
-  for (int q = 0; q < kN; ++q) stageLoad(p[q], v, w, s[q]);
+  for (int q = 0; q < kN; ++q) stageLoad(p[q], v, w, invM, invI, s[q]);
   for (int q = 0; q < kN; ++q) stageNormal(p[q], s[q]);
   for (int q = 0; q < kN; ++q) stageFriction(p[q], s[q]);
   for (int q = 0; q < kN; ++q) stageRolling(p[q], s[q]);
@@ -338,6 +353,225 @@ SCREE_AVX2 __attribute__((noinline)) Real solvePacketsAvx2(GranularStage::Packet
   return std::max(std::max(ad[0], ad[1]), std::max(ad[2], ad[3]));
 }
 
+// ---- Eight-wide sweep (issue 16, trench speed, seventh round) --------------------------------------------
+// Where the CPU has AVX-512 (this machine's Zen 5 executes 512-bit operations at full width), a run of two
+// packets of one level (8 units with 16 distinct particles) is solved in the eight lanes of 512-bit registers:
+// lanes 0-3 are the first packet's, 4-7 the second's. The packet layout and the schedule are the four-wide
+// sweep's; every lane does the same IEEE operations in the same order as the four-wide kernel (and so as the
+// scalar code): the stages below are stageNormal, stageFriction and stageRolling with 512-bit operations and
+// mask-register blends of the same predicates. AVX-512 includes FMA, so this file is compiled with
+// -ffp-contract=off (solver/CMakeLists.txt): no multiply-add is contracted, in any kernel.
+#define SCREE_AVX512 __attribute__((target("avx512f")))
+using P8 = __m512d;
+using M8 = __mmask8;
+
+// Halves and concatenation by __builtin_shufflevector, and the square root by its all-lanes masked form: GCC 12's
+// _mm512_extractf64x4_pd, _mm512_insertf64x4 and _mm512_sqrt_pd raise false -Wuninitialized warnings.
+SCREE_AVX512 inline P4 lo4(P8 x) { return __builtin_shufflevector(x, x, 0, 1, 2, 3); }
+SCREE_AVX512 inline P4 hi4(P8 x) { return __builtin_shufflevector(x, x, 4, 5, 6, 7); }
+SCREE_AVX512 inline P8 join8(P4 lo, P4 hi) { return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7); }
+SCREE_AVX512 inline P8 add8(P8 a, P8 b) { return _mm512_add_pd(a, b); }
+SCREE_AVX512 inline P8 sub8(P8 a, P8 b) { return _mm512_sub_pd(a, b); }
+SCREE_AVX512 inline P8 mul8(P8 a, P8 b) { return _mm512_mul_pd(a, b); }
+/// m ? b : a
+SCREE_AVX512 inline P8 sel8(P8 a, P8 b, M8 m) { return _mm512_mask_blend_pd(m, a, b); }
+SCREE_AVX512 inline P8 dot8(P8 ax, P8 ay, P8 az, P8 bx, P8 by, P8 bz) {
+  return add8(add8(mul8(ax, bx), mul8(ay, by)), mul8(az, bz));
+}
+SCREE_AVX512 inline P8 neg8(P8 a) {  // flips the sign bit, as the scalar unary minus
+  return _mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(a), _mm512_set1_epi64(int64_t(1) << 63)));
+}
+SCREE_AVX512 inline void projectDisc8(P8& l1, P8& l2, P8 lim) {
+  const P8 zero = _mm512_setzero_pd();
+  const P8 mag2 = add8(mul8(l1, l1), mul8(l2, l2));
+  const M8 over = _mm512_cmp_pd_mask(mag2, mul8(lim, lim), _CMP_GT_OQ);
+  const P8 mag = _mm512_maskz_sqrt_pd(M8(0xFF), mag2);
+  const P8 s = sel8(zero, _mm512_div_pd(lim, mag), _mm512_cmp_pd_mask(mag, zero, _CMP_GT_OQ));
+  l1 = sel8(l1, mul8(l1, s), over);
+  l2 = sel8(l2, mul8(l2, s), over);
+}
+/// Field k of two packets (lanes 0-3, 4-7), and back.
+SCREE_AVX512 inline P8 field8(const GranularStage::Packet* p, int k) {
+  return join8(_mm256_load_pd(p[0].f[k]), _mm256_load_pd(p[1].f[k]));
+}
+SCREE_AVX512 inline void storeField8(GranularStage::Packet* p, int k, P8 x) {
+  _mm256_store_pd(p[0].f[k], lo4(x));
+  _mm256_store_pd(p[1].f[k], hi4(x));
+}
+SCREE_AVX512 inline void load3x8(const Vec3* arr, const uint32_t* idx0, const uint32_t* idx1, P8& X, P8& Y, P8& Z) {
+  P4 x0, y0, z0, x1, y1, z1;
+  load3(arr, idx0, x0, y0, z0);
+  load3(arr, idx1, x1, y1, z1);
+  X = join8(x0, x1);
+  Y = join8(y0, y1);
+  Z = join8(z0, z1);
+}
+SCREE_AVX512 inline void store3x8(Vec3* arr, const uint32_t* idx0, const uint32_t* idx1, P8 X, P8 Y, P8 Z) {
+  store3(arr, idx0, lo4(X), lo4(Y), lo4(Z));
+  store3(arr, idx1, hi4(X), hi4(Y), hi4(Z));
+}
+
+struct LaneState8 {
+  P8 vax, vay, vaz, vbx, vby, vbz, wax, way, waz, wbx, wby, wbz;
+  P8 ima, imb, iIa, iIb;
+  P8 lNpos, absD;
+};
+
+SCREE_AVX512 inline void stageLoad8(const GranularStage::Packet* p, const Vec3* v, const Vec3* w, const Real* invM,
+                                    const Real* invI, LaneState8& s) {
+  s.ima = join8(gather4(invM, p[0].a), gather4(invM, p[1].a));
+  s.imb = join8(gather4(invM, p[0].b), gather4(invM, p[1].b));
+  s.iIa = join8(gather4(invI, p[0].a), gather4(invI, p[1].a));
+  s.iIb = join8(gather4(invI, p[0].b), gather4(invI, p[1].b));
+  load3x8(v, p[0].a, p[1].a, s.vax, s.vay, s.vaz);
+  load3x8(v, p[0].b, p[1].b, s.vbx, s.vby, s.vbz);
+  load3x8(w, p[0].a, p[1].a, s.wax, s.way, s.waz);
+  load3x8(w, p[0].b, p[1].b, s.wbx, s.wby, s.wbz);
+}
+
+SCREE_AVX512 inline void stageStore8(const GranularStage::Packet* p, Vec3* v, Vec3* w, const LaneState8& s) {
+  store3x8(v, p[0].a, p[1].a, s.vax, s.vay, s.vaz);
+  store3x8(v, p[0].b, p[1].b, s.vbx, s.vby, s.vbz);
+  store3x8(w, p[0].a, p[1].a, s.wax, s.way, s.waz);
+  store3x8(w, p[0].b, p[1].b, s.wbx, s.wby, s.wbz);
+}
+
+/// stageNormal in eight lanes.
+SCREE_AVX512 inline void stageNormal8(GranularStage::Packet* p, LaneState8& s) {
+  using G = GranularStage;
+  const P8 zero = _mm512_setzero_pd();
+  const P8 nx = field8(p, G::kNx), ny = field8(p, G::kNy), nz = field8(p, G::kNz);
+  const P8 ima = s.ima, imb = s.imb;
+  const P8 lN = field8(p, G::kLN);
+  const P8 vn = dot8(nx, ny, nz, sub8(s.vax, s.vbx), sub8(s.vay, s.vby), sub8(s.vaz, s.vbz));
+  P8 nl = add8(lN, mul8(sub8(sub8(field8(p, G::kRhsN), vn), mul8(field8(p, G::kEN), lN)), field8(p, G::kKN)));
+  const P8 lo = field8(p, G::kLoN);
+  nl = sel8(nl, lo, _mm512_cmp_pd_mask(nl, lo, _CMP_LT_OQ));  // std::max(nl, lo)
+  const P8 d = sub8(nl, lN);
+  storeField8(p, G::kLN, nl);
+  const M8 moved = _mm512_cmp_pd_mask(d, zero, _CMP_NEQ_UQ);
+  const P8 px = mul8(d, nx), py = mul8(d, ny), pz = mul8(d, nz);
+  s.vax = sel8(s.vax, add8(s.vax, mul8(ima, px)), moved);
+  s.vay = sel8(s.vay, add8(s.vay, mul8(ima, py)), moved);
+  s.vaz = sel8(s.vaz, add8(s.vaz, mul8(ima, pz)), moved);
+  s.vbx = sel8(s.vbx, sub8(s.vbx, mul8(imb, px)), moved);
+  s.vby = sel8(s.vby, sub8(s.vby, mul8(imb, py)), moved);
+  s.vbz = sel8(s.vbz, sub8(s.vbz, mul8(imb, pz)), moved);
+  s.lNpos = sel8(nl, zero, _mm512_cmp_pd_mask(nl, zero, _CMP_LT_OQ));  // std::max(lN, 0)
+  s.absD = _mm512_abs_pd(d);
+}
+
+/// stageFriction in eight lanes.
+SCREE_AVX512 inline void stageFriction8(GranularStage::Packet* p, LaneState8& s) {
+  using G = GranularStage;
+  const P8 zero = _mm512_setzero_pd();
+  const P8 t1x = field8(p, G::kT1x), t1y = field8(p, G::kT1y), t1z = field8(p, G::kT1z);
+  const P8 t2x = field8(p, G::kT2x), t2y = field8(p, G::kT2y), t2z = field8(p, G::kT2z);
+  const P8 eT = field8(p, G::kET);
+  const P8 mu = field8(p, G::kMu);
+  const P8 lim = mul8(mu, s.lNpos);
+  const P8 lT1 = field8(p, G::kLT1), lT2 = field8(p, G::kLT2);
+  const P8 la = field8(p, G::kLa), lb = field8(p, G::kLb), sigma = field8(p, G::kSigma);
+  const P8 dvx = sub8(s.vax, s.vbx), dvy = sub8(s.vay, s.vby), dvz = sub8(s.vaz, s.vbz);
+  const P8 Lx = add8(mul8(la, s.wax), mul8(lb, s.wbx)), Ly = add8(mul8(la, s.way), mul8(lb, s.wby)),
+           Lz = add8(mul8(la, s.waz), mul8(lb, s.wbz));
+  const P8 vt1 = sub8(dot8(t1x, t1y, t1z, dvx, dvy, dvz), mul8(sigma, dot8(Lx, Ly, Lz, t2x, t2y, t2z)));
+  const P8 vt2 = add8(dot8(t2x, t2y, t2z, dvx, dvy, dvz), mul8(sigma, dot8(Lx, Ly, Lz, t1x, t1y, t1z)));
+  const P8 kT = field8(p, G::kKT);
+  P8 l1 = add8(lT1, mul8(sub8(sub8(zero, vt1), mul8(eT, lT1)), kT));  // rhsT1 = +0 (see packable)
+  P8 l2 = add8(lT2, mul8(sub8(sub8(zero, vt2), mul8(eT, lT2)), kT));
+  projectDisc8(l1, l2, lim);
+  const M8 bounded = _mm512_cmp_pd_mask(lim, zero, _CMP_NEQ_UQ);
+  l1 = sel8(zero, l1, bounded);
+  l2 = sel8(zero, l2, bounded);
+  const M8 has = _mm512_cmp_pd_mask(mu, zero, _CMP_GT_OQ);
+  l1 = sel8(lT1, l1, has);
+  l2 = sel8(lT2, l2, has);
+  const P8 d1 = sub8(l1, lT1), d2 = sub8(l2, lT2);
+  storeField8(p, G::kLT1, l1);
+  storeField8(p, G::kLT2, l2);
+  const M8 moved = M8(_mm512_cmp_pd_mask(d1, zero, _CMP_NEQ_UQ) | _mm512_cmp_pd_mask(d2, zero, _CMP_NEQ_UQ));
+  const P8 px = add8(mul8(d1, t1x), mul8(d2, t2x)), py = add8(mul8(d1, t1y), mul8(d2, t2y)),
+           pz = add8(mul8(d1, t1z), mul8(d2, t2z));
+  const P8 qx = mul8(sigma, sub8(mul8(d1, t2x), mul8(d2, t1x))), qy = mul8(sigma, sub8(mul8(d1, t2y), mul8(d2, t1y))),
+           qz = mul8(sigma, sub8(mul8(d1, t2z), mul8(d2, t1z)));  // n x P
+  const P8 ima = s.ima, imb = s.imb;
+  const P8 iia = mul8(s.iIa, la), iib = mul8(s.iIb, lb);
+  s.vax = sel8(s.vax, add8(s.vax, mul8(ima, px)), moved);
+  s.vay = sel8(s.vay, add8(s.vay, mul8(ima, py)), moved);
+  s.vaz = sel8(s.vaz, add8(s.vaz, mul8(ima, pz)), moved);
+  s.wax = sel8(s.wax, sub8(s.wax, mul8(iia, qx)), moved);
+  s.way = sel8(s.way, sub8(s.way, mul8(iia, qy)), moved);
+  s.waz = sel8(s.waz, sub8(s.waz, mul8(iia, qz)), moved);
+  s.vbx = sel8(s.vbx, sub8(s.vbx, mul8(imb, px)), moved);
+  s.vby = sel8(s.vby, sub8(s.vby, mul8(imb, py)), moved);
+  s.vbz = sel8(s.vbz, sub8(s.vbz, mul8(imb, pz)), moved);
+  s.wbx = sel8(s.wbx, sub8(s.wbx, mul8(iib, qx)), moved);
+  s.wby = sel8(s.wby, sub8(s.wby, mul8(iib, qy)), moved);
+  s.wbz = sel8(s.wbz, sub8(s.wbz, mul8(iib, qz)), moved);
+}
+
+/// stageRolling in eight lanes.
+SCREE_AVX512 inline void stageRolling8(GranularStage::Packet* p, LaneState8& s) {
+  using G = GranularStage;
+  const P8 zero = _mm512_setzero_pd();
+  const P8 t1x = field8(p, G::kT1x), t1y = field8(p, G::kT1y), t1z = field8(p, G::kT1z);
+  const P8 t2x = field8(p, G::kT2x), t2y = field8(p, G::kT2y), t2z = field8(p, G::kT2z);
+  const P8 eT = field8(p, G::kET);
+  const P8 rollMu = field8(p, G::kRollMu), kR = field8(p, G::kKR);
+  const M8 has = M8(_mm512_cmp_pd_mask(rollMu, zero, _CMP_GT_OQ) & _mm512_cmp_pd_mask(kR, zero, _CMP_GT_OQ));
+  const P8 lim = mul8(rollMu, s.lNpos);
+  const P8 lR1 = field8(p, G::kLR1), lR2 = field8(p, G::kLR2);
+  const P8 rx = sub8(s.wax, s.wbx), ry = sub8(s.way, s.wby), rz = sub8(s.waz, s.wbz);
+  const P8 n1 = neg8(dot8(t1x, t1y, t1z, rx, ry, rz));
+  const P8 n2 = neg8(dot8(t2x, t2y, t2z, rx, ry, rz));
+  P8 l1 = add8(lR1, mul8(sub8(n1, mul8(eT, lR1)), kR));
+  P8 l2 = add8(lR2, mul8(sub8(n2, mul8(eT, lR2)), kR));
+  projectDisc8(l1, l2, lim);
+  const M8 bounded = _mm512_cmp_pd_mask(lim, zero, _CMP_NEQ_UQ);
+  l1 = sel8(zero, l1, bounded);
+  l2 = sel8(zero, l2, bounded);
+  const P8 c1 = sub8(l1, lR1), c2 = sub8(l2, lR2);
+  const P8 tx = add8(mul8(c1, t1x), mul8(c2, t2x)), ty = add8(mul8(c1, t1y), mul8(c2, t2y)),
+           tz = add8(mul8(c1, t1z), mul8(c2, t2z));
+  storeField8(p, G::kLR1, sel8(lR1, l1, has));
+  storeField8(p, G::kLR2, sel8(lR2, l2, has));
+  const P8 iA = s.iIa, iB = s.iIb;
+  s.wax = sel8(s.wax, add8(s.wax, mul8(iA, tx)), has);
+  s.way = sel8(s.way, add8(s.way, mul8(iA, ty)), has);
+  s.waz = sel8(s.waz, add8(s.waz, mul8(iA, tz)), has);
+  s.wbx = sel8(s.wbx, sub8(s.wbx, mul8(iB, tx)), has);
+  s.wby = sel8(s.wby, sub8(s.wby, mul8(iB, ty)), has);
+  s.wbz = sel8(s.wbz, sub8(s.wbz, mul8(iB, tz)), has);
+}
+
+/// solvePacketsAvx2<2 kZ> in eight lanes: kZ pairs of packets (2 kZ packets of one level). Returns the largest
+/// |delta lambda_n|, folded in the four-wide kernel's order.
+template <int kZ>
+SCREE_AVX512 __attribute__((noinline)) Real solvePacketsAvx512(GranularStage::Packet* p, Vec3* v, Vec3* w,
+                                                              const Real* invM, const Real* invI) {
+  LaneState8 s[kZ];
+  for (int q = 0; q < kZ; ++q) stageLoad8(p + 2 * q, v, w, invM, invI, s[q]);
+  for (int q = 0; q < kZ; ++q) stageNormal8(p + 2 * q, s[q]);
+  for (int q = 0; q < kZ; ++q) stageFriction8(p + 2 * q, s[q]);
+  for (int q = 0; q < kZ; ++q) stageRolling8(p + 2 * q, s[q]);
+  for (int q = 0; q < kZ; ++q) stageStore8(p + 2 * q, v, w, s[q]);
+  P4 m = lo4(s[0].absD);
+  m = _mm256_max_pd(m, hi4(s[0].absD));
+  for (int q = 1; q < kZ; ++q) {
+    m = _mm256_max_pd(m, lo4(s[q].absD));
+    m = _mm256_max_pd(m, hi4(s[q].absD));
+  }
+  alignas(32) double ad[4];
+  _mm256_store_pd(ad, m);
+  return std::max(std::max(ad[0], ad[1]), std::max(ad[2], ad[3]));
+}
+
+bool cpuHasAvx512() {
+  static const bool has = __builtin_cpu_supports("avx512f");
+  return has;
+}
+
 bool cpuHasAvx2() {
   static const bool has = __builtin_cpu_supports("avx2");
   return has;
@@ -345,7 +579,10 @@ bool cpuHasAvx2() {
 #else
 bool cpuHasAvx2() { return false; }
 template <int kN>
-Real solvePacketsAvx2(GranularStage::Packet*, Vec3*, Vec3*) { return 0; }
+Real solvePacketsAvx2(GranularStage::Packet*, Vec3*, Vec3*, const Real*, const Real*) { return 0; }
+bool cpuHasAvx512() { return false; }
+template <int kZ>
+Real solvePacketsAvx512(GranularStage::Packet*, Vec3*, Vec3*, const Real*, const Real*) { return 0; }
 #endif
 
 }  // namespace
@@ -483,6 +720,7 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
   // particles, body and solve type), so that each unit is built directly in its place in units_ (a copy of
   // all units, some 8 MB in the trench bench, was 3.5 % of it). Same order as building and then partitioning.
   plan_.resize(numUnits);
+  warm_.resize(pp.size() + pg.size());
   // Without any DIRECT-mode material pair (the usual case) no unit is DIRECT: the plan needs only a contact's
   // first bytes (a, b), not the rest of its 168.
   bool anyDirect = false;
@@ -500,6 +738,16 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     e.b = isPP ? c.b : -1;
     e.body = isPP ? -1 : pgBody[k - pp.size()];
     e.direct = false;
+    // The warm-start entry is looked up here, where the contact's keys are read anyway, so that the unit loop
+    // below can fetch it ahead (the entries, 2 MB in storeResults order, are met in contact order: waiting for
+    // them was a quarter of the unit loop; docs/terrain.md, "Digging cost", seventh round).
+    if (isPP) {
+      const uint64_t sa = slotKey(ps, c.a), sb = slotKey(ps, size_t(c.b));
+      warm_[k] = find(ppKeys_, ppFirst_, ppCache_, sa > sb ? (sb << 32 | sa) : (sa << 32 | sb), 0);
+    } else {
+      warm_[k] = find(pgKeys_, pgFirst_, pgCache_, slotKey(ps, c.a) << 32 | sides[k - pp.size()].geometryId,
+                      c.featureId);
+    }
     if (!anyDirect) continue;
     const bool deadPair = !ps.isAliveDense(c.a) || (isPP && !ps.isAliveDense(size_t(c.b)));
     if (deadPair || !c.enabled) continue;  // inert: iterative
@@ -529,6 +777,11 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
     const bool isPP = k < pp.size();
     const ParticleContact& c = isPP ? pp[k] : pg[k - pp.size()];
     if (!isPP && c.sensor) continue;
+    if (k + 8 < warm_.size() && warm_[k + 8]) {  // the entry of a later contact (no effect on results)
+      const char* e = reinterpret_cast<const char*>(warm_[k + 8]);
+      __builtin_prefetch(e);
+      __builtin_prefetch(e + sizeof(CacheEntry) - 1);
+    }
     const uint32_t dest = unitDest_[isPP ? k : pgUnit[k - pp.size()]];
     Unit& u = units_[dest];
     u = Unit{};
@@ -597,17 +850,11 @@ void GranularStage::buildRows(GranularBodySystem& ps, const ParticleContactLists
       if (gr > 0) rollR = r[a] * gr / (r[a] + gr);
     }
     // Warm start and remembered impact speed.
-    const CacheEntry* ce = nullptr;
+    const CacheEntry* ce = warm_[k];  // found by the plan loop above
     Real sgn = 1.0;
-    {
-      if (isPP) {
-        const uint64_t sa = slotKey(ps, a), sb = slotKey(ps, size_t(c.b));
-        u.flip = sa > sb;
-        sgn = u.flip ? -1.0 : 1.0;
-        ce = find(ppKeys_, ppFirst_, ppCache_, u.flip ? (sb << 32 | sa) : (sa << 32 | sb), 0);
-      } else {
-        ce = find(pgKeys_, pgFirst_, pgCache_, slotKey(ps, a) << 32 | sides[k - pp.size()].geometryId, c.featureId);
-      }
+    if (isPP) {
+      u.flip = slotKey(ps, a) > slotKey(ps, size_t(c.b));
+      sgn = u.flip ? -1.0 : 1.0;
     }
     uint64_t pairKey = 0;  // only glued bonds need it (bondRest_)
     if (isPP && anyBondRest) {
@@ -930,6 +1177,7 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
   const int S = numSlabs_;
   // Four-wide sweep (see "Four-wide sweep" above): each slab's units in level order, centred ones in packets.
   const bool vec = gVectorSweepEnabled && cpuHasAvx2() && !units_.empty();
+  const bool wide = vec && gWideSweepEnabled && cpuHasAvx512();
   if (vec) {
     if (scheduleStale_) {
       buildSchedule(ps);
@@ -945,17 +1193,33 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
   auto runSlab = [&](int sl) {
     if (!vec) return runRange(slabStart_[size_t(sl)], slabStart_[size_t(sl) + 1]);
     Real md = 0;
+    uint64_t wideUnits = 0;
+    const Real* im = invM.data();
+    const Real* ii = invInertia_.data();
     const uint32_t i0 = itemStart_[size_t(sl)], i1 = itemStart_[size_t(sl) + 1];
     auto item = [&](int32_t it) SCREE_UNIT_INLINE {
       if (it >= 0) one(units_[size_t(it)], md);
       else {
         const uint32_t code = uint32_t(-1 - it);
         Packet* p = &packets_[code >> 2];
+        if (wide) {  // eight-wide: pairs of packets in 512-bit lanes, a last odd packet four-wide
+          wideUnits += (code & 3) >= 1 ? ((code & 3) == 3 ? 16 : 8) : 0;
+          switch (code & 3) {
+            case 0: md = std::max(md, solvePacketsAvx2<1>(p, v.data(), w.data(), im, ii)); break;
+            case 1: md = std::max(md, solvePacketsAvx512<1>(p, v.data(), w.data(), im, ii)); break;
+            case 2:
+              md = std::max(md, solvePacketsAvx512<1>(p, v.data(), w.data(), im, ii));
+              md = std::max(md, solvePacketsAvx2<1>(p + 2, v.data(), w.data(), im, ii));
+              break;
+            default: md = std::max(md, solvePacketsAvx512<2>(p, v.data(), w.data(), im, ii)); break;
+          }
+          return;
+        }
         switch (code & 3) {
-          case 0: md = std::max(md, solvePacketsAvx2<1>(p, v.data(), w.data())); break;
-          case 1: md = std::max(md, solvePacketsAvx2<2>(p, v.data(), w.data())); break;
-          case 2: md = std::max(md, solvePacketsAvx2<3>(p, v.data(), w.data())); break;
-          default: md = std::max(md, solvePacketsAvx2<4>(p, v.data(), w.data())); break;
+          case 0: md = std::max(md, solvePacketsAvx2<1>(p, v.data(), w.data(), im, ii)); break;
+          case 1: md = std::max(md, solvePacketsAvx2<2>(p, v.data(), w.data(), im, ii)); break;
+          case 2: md = std::max(md, solvePacketsAvx2<3>(p, v.data(), w.data(), im, ii)); break;
+          default: md = std::max(md, solvePacketsAvx2<4>(p, v.data(), w.data(), im, ii)); break;
         }
       }
     };
@@ -984,6 +1248,7 @@ Real GranularStage::sweep(GranularBodySystem& ps, std::vector<SolverBodyState>& 
         if (i >= i0 + kAheadItems) fetch(items_[i - kAheadItems]);
         item(items_[i]);
       }
+    if (wideUnits) gWideUnits += wideUnits;
     return md;
   };
   const uint32_t serialBegin = slabStart_[size_t(S)], serialEnd = slabStart_[size_t(S) + 1];
@@ -1012,6 +1277,12 @@ bool GranularStage::vectorSweepAvailable() { return gVectorSweepEnabled && cpuHa
 void GranularStage::setVectorSweepEnabled(bool on) { gVectorSweepEnabled = on; }
 
 uint64_t GranularStage::packedUnitsTotal() { return gPackedUnits.load(); }
+
+bool GranularStage::avx512SweepAvailable() { return vectorSweepAvailable() && gWideSweepEnabled && cpuHasAvx512(); }
+
+void GranularStage::setAvx512SweepEnabled(bool on) { gWideSweepEnabled = on; }
+
+uint64_t GranularStage::wideUnitsTotal() { return gWideUnits.load(); }
 
 bool GranularStage::packable(const Unit& u) {
   // +0 friction targets (no surface velocity) and equal tangent gains: the packet's reduced fields.
@@ -1103,8 +1374,7 @@ void GranularStage::buildSchedule(const GranularBodySystem& ps) {
   gPackedUnits += 4 * numPackets_;
 }
 
-void GranularStage::pack(const GranularBodySystem& ps) {
-  const auto& invM = ps.invMasses();
+void GranularStage::pack(const GranularBodySystem&) {
   // The units are read in level order, scattered over units_: the next packet's are fetched ahead.
   constexpr size_t kAhead = 2;
   for (size_t q = 0; q < numPackets_; ++q) {
@@ -1142,10 +1412,6 @@ void GranularStage::pack(const GranularBodySystem& ps) {
       f[kMu][j] = u.mu;
       f[kRollMu][j] = u.rollMu;
       f[kKR][j] = u.kR;
-      f[kImA][j] = invM[a];
-      f[kImB][j] = invM[b];
-      f[kInvIA][j] = invInertia_[a];
-      f[kInvIB][j] = invInertia_[b];
       f[kLN][j] = u.lN;
       f[kLT1][j] = u.lT1;
       f[kLT2][j] = u.lT2;

@@ -33,7 +33,9 @@
 //                Four-wide sweep (where the CPU has AVX2): each slab's units are swept in dependency-level order
 //                and centred units of one level, which share no particle, four at a time in SIMD lanes; the
 //                result is the scalar sweep's bit for bit (the .cpp's "Four-wide sweep" says why; memory, not
-//                arithmetic, bounds it, so the packets are prefetched).
+//                arithmetic, bounds it, so the packets are prefetched). Where the CPU has AVX-512, two packets of
+//                a level are solved at once in the eight lanes of 512-bit registers (the .cpp's "Eight-wide
+//                sweep"), again bit for bit.
 //   integrate    x += h v for live particles; a particle whose velocity or position turns non-finite is
 //                reported by id, keeps its last position and is stopped. Clusters joined by glued DIRECT bonds
 //                move by their exactly integrated rigid motion first (integrateBondedLumps, below).
@@ -173,6 +175,13 @@ class GranularStage {
   /// Units put into packets since the process started, over all stages (a test's evidence that the four-wide
   /// path ran).
   static uint64_t packedUnitsTotal();
+  /// Whether the sweep solves pairs of packets in the eight lanes of AVX-512 registers (the .cpp's "Eight-wide
+  /// sweep"; needs vectorSweepAvailable()); bit-identical to the four-wide and the scalar sweep.
+  static bool avx512SweepAvailable();
+  /// Test and measurement switch: false keeps the four-wide kernel on an AVX-512 CPU. Default true.
+  static void setAvx512SweepEnabled(bool on);
+  /// Unit visits solved by the eight-wide kernel since the process started (a test's evidence that it ran).
+  static uint64_t wideUnitsTotal();
 
  private:
   // One contact point between particle a and particle b or a geometry (its rigid body index `body`, -1 none).
@@ -246,6 +255,7 @@ class GranularStage {
     bool direct = false;  // the contact material's solve type is not ITERATIVE (DIRECT mode)
   };
   std::vector<UnitPlan> plan_;
+  std::vector<const CacheEntry*> warm_;  // [pp + pg contacts] the warm-start entry of each contact, or null
   std::vector<uint32_t> unitDest_;
   std::vector<uint16_t> slabOf_;
   std::vector<uint32_t> slabCount_, slabCursor_;
@@ -292,11 +302,11 @@ class GranularStage {
  public:
   // Four centred units with 8 distinct particles, lane-interleaved (field f of lane j at f[f][j]): the unit data
   // the sweep reads (a centred unit's two tangent gains are equal: one kKT; packed units have no surface
-  // velocity, so the friction targets are zero), the particles' inverse masses and inertias, and the impulses (the authoritative copy while
+  // velocity, so the friction targets are zero), and the impulses (the authoritative copy while
   // packed_, written back to the units by unpack()).
   enum PacketField : int {
     kNx, kNy, kNz, kT1x, kT1y, kT1z, kT2x, kT2y, kT2z, kSigma, kLa, kLb, kKN, kKT, kRhsN, kEN, kLoN, kET, kMu,
-    kRollMu, kKR, kImA, kImB, kInvIA, kInvIB, kLN, kLT1, kLT2, kLR1, kLR2, kNumPacketFields
+    kRollMu, kKR, kLN, kLT1, kLT2, kLR1, kLR2, kNumPacketFields
   };
   struct alignas(32) Packet {
     uint32_t a[4], b[4];  // first: the kernel reads them first (then the particles' velocities)
