@@ -1,3 +1,5 @@
+// SPDX-License-Identifier: MIT
+// Copyright (c) 2026 The Scree authors
 // The particle pair search's two-speed grid (collide/include/scree/collide/particle_collider.h, "Two-speed
 // grid") against a brute-force search over all pairs, step after step, on a moving cloud like the trench's:
 // a block carried at a common velocity (the bucket's soil), particles at rest (the ground's heap), and fast ones
