@@ -20,6 +20,7 @@
 
 #include <scree/scree.h>
 #include "scree/collide/particle_collider.h"
+#include "particle_pairs_brute.h"
 
 using namespace scree;
 
@@ -38,35 +39,9 @@ struct Rng {
   Vec3 direction() { return Vec3(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5); }
 };
 
-using Pairs = std::vector<std::pair<uint32_t, int32_t>>;
-
-Pairs pairsOf(const detail::ParticleCollider& c) {
-  Pairs out;
-  for (const ParticleContact& pc : c.getParticleParticleContacts()) out.emplace_back(pc.a, pc.b);
-  return out;
-}
-
-Pairs bruteForce(const GranularBodySystem& ps, Real h, Real margin) {
-  const auto& x = ps.positions();
-  const auto& v = ps.velocities();
-  const auto& r = ps.radii();
-  Real maxR = 0, maxV = 0;
-  for (size_t i = 0; i < ps.size(); ++i) {
-    maxR = std::max(maxR, r[i]);
-    maxV = std::max(maxV, v[i].squaredNorm());
-  }
-  const Real reach = std::min(2 * std::sqrt(maxV) * h + margin, 2 * maxR);
-  Pairs out;
-  for (size_t a = 0; a < ps.size(); ++a) {
-    if (!ps.isAliveDense(a)) continue;
-    for (size_t b = a + 1; b < ps.size(); ++b) {
-      if (!ps.isAliveDense(b)) continue;
-      const Real lim = r[a] + r[b] + std::min(h * (v[a] - v[b]).norm() + margin, reach);
-      if ((x[a] - x[b]).squaredNorm() < lim * lim) out.emplace_back(uint32_t(a), int32_t(b));
-    }
-  }
-  return out;
-}
+using Pairs = test::ParticlePairs;
+using test::bruteForce;
+using test::pairsOf;
 }  // namespace
 
 TEST_SUITE("granular") {
