@@ -37,8 +37,10 @@ namespace detail {
 struct SimulationState;
 }
 
-/// Wall-clock time of each stage of the last step, in seconds (steady clock), in step order, and counts. The
-/// sums `collide`, `rows` and `integrate` keep their earlier meaning.
+/// Wall-clock time of each stage of the last step, in seconds, in step order, and counts. The step's two ends
+/// read the steady clock; the stage boundaries read a tick counter (the time-stamp counter on x86-64, see
+/// solver/src/simulation.cpp), and each stage gets the step's time times its share of the ticks, so the stages
+/// add up to the step. The sums `collide`, `rows` and `integrate` keep their earlier meaning.
 struct StepStats {
   double preCollide = 0;         ///< s, PRE_COLLIDE step listeners
   double syncGeometries = 0;     ///< s, geometries added to or removed from bodies since the last step -> space
