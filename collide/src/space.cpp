@@ -136,21 +136,28 @@ void Space::collide(Real h, std::vector<GeometryContact>& out) {
   // parallel option (or with too few chunks) the pairs are collided in the same order on the calling thread,
   // with no OpenMP region and no chunk buffers. An `omp parallel` region entered with `if (false)` still costs
   // libgomp a team allocation, a free and a futex wake, and the chunk buffers cost one more copy of every
-  // contact point: together about 0.6 us of mass_ratio's 4.9 us step (its collide stage went 1.27 -> 0.68 us). Here each pair is collided into one scratch buffer that
-  // then trades storage with the contact's (a swap, no copy; the buffers keep their capacity, so a steady scene
-  // allocates nothing). Both paths give the same contacts in the same order.
+  // contact point: together about 0.6 us of mass_ratio's 4.9 us step (its collide stage went 1.27 -> 0.68 us).
+  // Here each pair is collided into one scratch buffer that then trades storage with the contact's (a swap, no
+  // copy; the buffers keep their capacity, so a steady scene allocates nothing). Both paths collide a pair with
+  // `narrow` below, so they give the same contacts in the same order.
   constexpr size_t kChunkPairs = 64;
   const size_t numChunks = (pairs_.size() + kChunkPairs - 1) / kChunkPairs;
   const bool parallel = parallelNarrowphase_ && numChunks >= 4;
+  // The narrowphase of candidate pair k: its points into `points` (cleared first), its geometries in id order
+  // into (ga, gb); false when the pair is filtered out or does not touch.
+  auto narrow = [this](size_t k, std::vector<ContactPoint>& points, Geometry*& ga, Geometry*& gb) {
+    const auto [i, j] = pairs_[k];
+    ga = geoms_[i].get();
+    gb = geoms_[j].get();
+    if (!canCollide(*ga, *gb)) return false;
+    if (ga->getId() > gb->getId()) std::swap(ga, gb);
+    points.clear();
+    return collideGeometries(*ga, *gb, margins_[i] + margins_[j], points) > 0 && !points.empty();
+  };
   if (!parallel) {
-    for (const auto& [i, j] : pairs_) {
-      Geometry* ga = geoms_[i].get();
-      Geometry* gb = geoms_[j].get();
-      if (!canCollide(*ga, *gb)) continue;
-      const Real pairMargin = margins_[i] + margins_[j];
-      if (ga->getId() > gb->getId()) std::swap(ga, gb);
-      serialScratch_.clear();
-      if (collideGeometries(*ga, *gb, pairMargin, serialScratch_) <= 0 || serialScratch_.empty()) continue;
+    for (size_t k = 0; k < pairs_.size(); ++k) {
+      Geometry *ga, *gb;
+      if (!narrow(k, serialScratch_, ga, gb)) continue;
       if (used == out.size()) out.emplace_back();
       GeometryContact& gc = out[used++];
       gc.reset(ga, gb, ga->getRigidBody(), gb->getRigidBody());  // clears its points, keeps their storage
@@ -166,14 +173,8 @@ void Space::collide(Real h, std::vector<GeometryContact>& out) {
       ch.hits.clear();
       const size_t end = std::min(pairs_.size(), (c + 1) * kChunkPairs);
       for (size_t k = c * kChunkPairs; k < end; ++k) {
-        const auto [i, j] = pairs_[k];
-        Geometry* ga = geoms_[i].get();
-        Geometry* gb = geoms_[j].get();
-        if (!canCollide(*ga, *gb)) continue;
-        const Real pairMargin = margins_[i] + margins_[j];
-        if (ga->getId() > gb->getId()) std::swap(ga, gb);
-        ch.scratch.clear();
-        if (collideGeometries(*ga, *gb, pairMargin, ch.scratch) <= 0 || ch.scratch.empty()) continue;
+        Geometry *ga, *gb;
+        if (!narrow(k, ch.scratch, ga, gb)) continue;
         ch.hits.push_back({ga, gb, uint32_t(ch.points.size()), uint32_t(ch.scratch.size())});
         ch.points.insert(ch.points.end(), ch.scratch.begin(), ch.scratch.end());
       }
