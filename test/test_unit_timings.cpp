@@ -41,6 +41,52 @@ TEST_CASE("getTimings: milliseconds per stage that add up to the step's total wi
   }
 }
 
+TEST_CASE("getTimings: each stage's time lands in its own field; idle stages report exactly 0") {
+  // The step reads a tick counter at each stage boundary and hands each field the step's time times its share of
+  // the ticks (solver/src/simulation.cpp), so a field mixed up with another would show another stage's time.
+  // Listeners that spin for known durations (1, 2 and 4 ms of steady-clock time, each far above the other
+  // stages' microseconds) give the three listener fields lower bounds; a swapped or shifted field would read a
+  // few microseconds instead. Being descheduled only lengthens a stage, so the bounds hold on a busy machine.
+  TestWorld w(1.0 / 60.0, 9.81);
+  w.addGround();
+  for (int i = 0; i < 5; ++i) w.addBox(Vec3(0.3, 0.3, 0.3), Vec3(0, 0, 0.3 + 0.6 * i), 216.0);
+  w.steps(2);
+  // No listeners, constraints, particles or projected ranges: those stages are idle and read 0 exactly.
+  StepTimings t = w.sim->getTimings();
+  CHECK(t.preCollide == 0);
+  CHECK(t.pre == 0);
+  CHECK(t.post == 0);
+  CHECK(t.constraintRows == 0);
+  CHECK(t.collideParticles == 0);
+  CHECK(t.particleRows == 0);
+  CHECK(t.projectPositions == 0);
+  CHECK(t.compactParticles == 0);
+  CHECK(t.solve > 0);
+
+  struct Spinner : StepEventListener {
+    Spinner() : StepEventListener(ALL) {}
+    static void spin(double ms) {
+      const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double, std::milli>(ms);
+      while (std::chrono::steady_clock::now() < end) {
+      }
+    }
+    void preCollide(const TimeStamp&) override { spin(1.0); }
+    void pre(const TimeStamp&) override { spin(2.0); }
+    void post(const TimeStamp&) override { spin(4.0); }
+  };
+  w.sim->add(std::static_pointer_cast<StepEventListener>(std::make_shared<Spinner>()));
+  for (int step = 0; step < 3; ++step) {
+    w.steps(1);
+    t = w.sim->getTimings();
+    // The share of ticks and the steady clock measure the same wall time; 2 % covers their rates' mismatch.
+    CHECK(t.preCollide >= 0.98 * 1.0);
+    CHECK(t.pre >= 0.98 * 2.0);
+    CHECK(t.post >= 0.98 * 4.0);
+    CHECK(t.total >= 0.98 * 7.0);
+    CHECK(t.sumOfStages() == doctest::Approx(t.total).epsilon(1e-9));
+  }
+}
+
 TEST_CASE("StepTimings += adds every field, total included") {
   // StepTimings is a plain struct of doubles: fill two with distinct powers of two through their bytes, so a
   // field that operator+= forgets (also one added later) shows up as a wrong element.
