@@ -16,3 +16,52 @@ void setNumThreads(int n);
 int getNumThreads();
 
 }  // namespace scree
+
+// ---- issue 18 (sweep scheduling): a persistent team of threads (core/src/parallel.cpp;
+// docs/solver-internals.md "Partitioned sweeps", "Persistent team") ----
+#include <atomic>
+#include <cstdint>
+#include <type_traits>
+
+namespace scree::detail {
+
+/// Runs `job(ctx, t, n)` for t = 0 .. n-1 at once, t = 0 on the calling thread, the others on threads of a team
+/// kept for the life of the process (created on first use, joined at exit); returns when every t is done.
+///
+/// DESIGN (why not `#pragma omp parallel`): libgomp's fork and join spin for GOMP_SPINCOUNT loads (by default
+/// tens of milliseconds' worth) before sleeping; with more runnable threads than cores, a spinning thread holds the
+/// core its partner needs, and the partitioned pyramid20 step took 10-35 ms on two threads instead of 1.5 ms on
+/// one. The team's threads spin `teamSpinCount()` loads (a few microseconds), then sleep on a futex (C++20
+/// std::atomic::wait); the caller waits the same way. On idle cores the partner is woken within the spin, so a
+/// fork-join costs about as much as one cache-line round trip (bench_rigid_stages BM_team_fork_join).
+/// Called from inside a job, or while another thread of the program uses the team, the job runs once on the
+/// calling thread as job(ctx, 0, 1): a job must split its work by (t, n) and give the same result for any n (the
+/// partitioned sweeps do), and must not wait for a partner when n is 1.
+void runTeamJob(int n, void (*job)(void*, int, int), void* ctx);
+
+/// runTeamJob with a callable `f(t, n)`.
+template <class F>
+void runTeam(int n, F&& f) {
+  using Fn = std::remove_reference_t<F>;
+  runTeamJob(n, [](void* c, int t, int nt) { (*static_cast<Fn*>(c))(t, nt); }, const_cast<void*>(static_cast<const void*>(&f)));
+}
+
+/// Loads a waiting thread spins before it sleeps (team, TeamBarrier, waitAtLeast).
+constexpr int teamSpinCount() { return 4000; }
+
+/// Waits until `a` holds at least `target`: spins teamSpinCount() loads, then sleeps on the atomic.
+void waitAtLeast(const std::atomic<uint32_t>& a, uint32_t target);
+
+/// A reusable barrier for a team of n threads (phase counting), spinning then sleeping like the team.
+class TeamBarrier {
+ public:
+  explicit TeamBarrier(int n) : n_(uint32_t(n)) {}
+  void wait();
+
+ private:
+  const uint32_t n_;
+  alignas(64) std::atomic<uint32_t> arrived_{0};
+  alignas(64) std::atomic<uint32_t> phase_{0};
+};
+
+}  // namespace scree::detail

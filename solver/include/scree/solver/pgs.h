@@ -165,6 +165,7 @@ struct PgsPartition {
     int32_t body;
   };
   std::vector<Remap> remapped;
+  std::vector<int32_t> unitManifold;  ///< per unit of `order`: its compact record (PgsBlocks::manifolds) or -1
   /// Shock pass (PgsSolver::shockPass with a partition): per range, the thread list it belongs to and how many
   /// ranges of the other list must be finished before it runs.
   std::vector<uint32_t> shockList[kRegions];
@@ -226,8 +227,9 @@ class PgsSolver {
   /// `iterations` partitioned sweeps (alternating forward and backward): forward, the regions (in parallel, or
   /// one after the other on one thread), then the boundary; backward, the boundary, then the regions, each
   /// unit's rows backward. Two barriers per pair of sweeps. Results do not depend on the number of threads.
+  /// With `blocks`, manifold contacts are swept from the compact records (as in the serial iterate above).
   static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
-                      const PgsBlocks* blocks, PgsPartition& partition);
+                      PgsBlocks* blocks, PgsPartition& partition);
   /// The shock pass (same law and order of dependencies as shockPass above, bit-identical to it): the ranges of
   /// each region's free bodies run on their own thread, waiting only for ranges of the other region whose free
   /// body is their frozen one (point-to-point, no barrier).
