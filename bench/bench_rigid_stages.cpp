@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "cpu_time.h"
+#include "scree/core/parallel.h"
 #include "scenes/scenes.h"
 
 // Counts every heap allocation of the process (this benchmark binary only; the replacement operator new pairs
@@ -177,6 +178,55 @@ void BM_pyramid20_noshock_stages(benchmark::State& state) {
 }
 BENCHMARK(BM_pyramid20_noshock_stages)->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// ---- issue 18 (sweep scheduling): the persistent team's costs (scree/core/parallel.h; docs/solver-internals.md
+// "Persistent team"). Arg = threads. BM_team_fork_join: one runTeam with an empty job (what a partitioned stage
+// pays to start and join); BM_omp_fork_join: the same with an empty `#pragma omp parallel` (what it paid before);
+// BM_team_barrier: one TeamBarrier::wait of every thread (what a partitioned sweep pays), 1000 per iteration,
+// time per barrier. On a loaded machine these measure the load (a descheduled partner costs a time slice).
+void BM_team_fork_join(benchmark::State& state) {
+  const int n = int(state.range(0));
+  int sink = 0;
+  for (auto _ : state) {
+    detail::runTeam(n, [&](int t, int) {
+      if (t == 0) ++sink;
+    });
+  }
+  benchmark::DoNotOptimize(sink);
+}
+BENCHMARK(BM_team_fork_join)->Arg(1)->Arg(2)->Repetitions(3)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+#ifdef SCREE_WITH_OPENMP
+void BM_omp_fork_join(benchmark::State& state) {
+  const int n = int(state.range(0));
+  int sink = 0;
+  for (auto _ : state) {
+#pragma omp parallel num_threads(n)
+    {
+#pragma omp master
+      ++sink;
+    }
+  }
+  benchmark::DoNotOptimize(sink);
+}
+BENCHMARK(BM_omp_fork_join)->Arg(1)->Arg(2)->Repetitions(3)->Unit(benchmark::kMicrosecond)->UseRealTime();
+#endif
+
+void BM_team_barrier(benchmark::State& state) {
+  const int n = int(state.range(0));
+  constexpr int kBarriers = 1000;
+  for (auto _ : state) {
+    detail::TeamBarrier barrier(n);
+    detail::runTeam(n, [&](int, int nt) {
+      if (nt > 1)
+        for (int k = 0; k < kBarriers; ++k) barrier.wait();
+    });
+  }
+  state.counters["s_per_barrier"] =
+      benchmark::Counter(double(state.iterations()) * kBarriers, benchmark::Counter::kIsRate |
+                                                                     benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_team_barrier)->Arg(2)->Repetitions(3)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 }  // namespace
 

@@ -5,11 +5,15 @@
 // threads.
 #include <doctest/doctest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstring>
 #include <set>
+#include <thread>
 #include <vector>
 
 #include "scenes/scenes.h"
+#include "scree/core/parallel.h"
 #include "scree/solver/pgs.h"
 
 using namespace scree;
@@ -190,6 +194,65 @@ TEST_CASE("partitioned sweeps: pyramid20 is bit-identical on 1 and 2 threads, wi
       CHECK(m1.maxDisplacement < 0.01);
     }
   }
+}
+
+// ---- issue 18 (sweep scheduling): the persistent team the partitioned stages run on (scree/core/parallel.h) ----
+TEST_CASE("persistent team: every index once on its own thread, barrier order, nested and concurrent calls") {
+  // Two indices, two distinct threads, t = 0 on the caller; repeated so that the sleeping worker is woken too.
+  for (int rep = 0; rep < 50; ++rep) {
+    std::thread::id who[2];
+    int seenN[2] = {0, 0}, runs[2] = {0, 0};
+    detail::runTeam(2, [&](int t, int n) {
+      who[t] = std::this_thread::get_id();
+      seenN[t] = n;
+      ++runs[t];
+    });
+    REQUIRE(runs[0] == 1);
+    REQUIRE(runs[1] == 1);
+    CHECK(seenN[0] == 2);
+    CHECK(who[0] == std::this_thread::get_id());
+    CHECK(who[1] != who[0]);
+    if (rep == 25) std::this_thread::sleep_for(std::chrono::milliseconds(5));  // the worker sleeps on its futex
+  }
+  // The barrier orders phases: after barrier k, each thread sees the other's write of phase k (a missing or early
+  // release shows up as a stale value on some phase).
+  constexpr int kPhases = 2000;
+  std::vector<int> a(kPhases, -1), b(kPhases, -1);
+  int stale = 0;
+  detail::TeamBarrier barrier(2);
+  detail::runTeam(2, [&](int t, int n) {
+    if (n < 2) return;
+    std::vector<int>& mine = t == 0 ? a : b;
+    const std::vector<int>& theirs = t == 0 ? b : a;
+    int bad = 0;
+    for (int k = 0; k < kPhases; ++k) {
+      mine[size_t(k)] = k;
+      barrier.wait();
+      bad += theirs[size_t(k)] != k;
+      barrier.wait();
+    }
+    if (t == 1) stale = bad;  // read after the join
+  });
+  CHECK(stale == 0);
+  CHECK(a.back() == kPhases - 1);
+  CHECK(b.back() == kPhases - 1);
+  // A job that calls the team again runs the inner job on its own thread with n = 1 (no deadlock); a second user
+  // thread that finds the team busy does the same. Both give the whole job's work once.
+  int inner[2] = {0, 0};
+  detail::runTeam(2, [&](int t, int) {
+    detail::runTeam(2, [&](int u, int n) { inner[t] += (u == 0 && n == 1) ? 1 : 100; });
+  });
+  CHECK(inner[0] == 1);
+  CHECK(inner[1] == 1);
+  std::atomic<int> total{0};
+  auto user = [&] {
+    for (int k = 0; k < 200; ++k)
+      detail::runTeam(2, [&](int t, int n) { total.fetch_add(n == 2 ? 1 : (t == 0 ? 2 : 1000)); });
+  };
+  std::thread other(user);
+  user();
+  other.join();
+  CHECK(total.load() == 800);  // every call's work done exactly once: 2 x 1 with the team, 1 x 2 without
 }
 
 }  // TEST_SUITE
