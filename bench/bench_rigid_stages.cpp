@@ -4,6 +4,10 @@
 // (docs/scenes.md), on 1 and 2 threads (issue 18: where a small rigid scene's step goes, and the two-thread
 // speed-up of the coloured sweeps, docs/solver-internals.md "Sweep cost" and "Coloured sweeps").
 //
+// The pyramid20 benchmarks' argument is the thread count (scree::setNumThreads). Issue 18's 2-thread check on an
+// idle machine: --benchmark_filter='pyramid20_(partitioned_)?stages|team|omp' (docs/solver-internals.md
+// "Partitioned sweeps", second round; BM_team_* and BM_omp_fork_join measure the synchronisation itself).
+//
 // One benchmark iteration is one complete run of the scene's defined steps (scene built with the timer paused).
 // Counters:
 //   median_ms   median wall time of one step over the run (ms)
