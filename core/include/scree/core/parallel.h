@@ -31,9 +31,11 @@ namespace scree::detail {
 /// DESIGN (why not `#pragma omp parallel`): libgomp's fork and join spin for GOMP_SPINCOUNT loads (by default
 /// tens of milliseconds' worth) before sleeping; with more runnable threads than cores, a spinning thread holds the
 /// core its partner needs, and the partitioned pyramid20 step took 10-35 ms on two threads instead of 1.5 ms on
-/// one. The team's threads spin `teamSpinCount()` loads (a few microseconds), then sleep on a futex (C++20
-/// std::atomic::wait); the caller waits the same way. On idle cores the partner is woken within the spin, so a
-/// fork-join costs about as much as one cache-line round trip (bench_rigid_stages BM_team_fork_join).
+/// one. Between jobs a worker spins for up to 2 ms, yielding every 256 loads (waking a sleeping worker through the
+/// futex cost about 0.2 ms in the KVM guest this was measured on, more than half the parallel work of a small
+/// scene's step), then sleeps on a futex (C++20 std::atomic::wait); the caller, the barrier and waitAtLeast spin
+/// `teamSpinCount()` loads, then sleep the same way. A fork-join to a spinning worker costs about 1 us
+/// (bench_rigid_stages BM_team_fork_join).
 /// Called from inside a job, or while another thread of the program uses the team, the job runs once on the
 /// calling thread as job(ctx, 0, 1): a job must split its work by (t, n) and give the same result for any n (the
 /// partitioned sweeps do), and must not wait for a partner when n is 1.
