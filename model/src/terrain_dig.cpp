@@ -464,11 +464,20 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
       const long long kz0 = (long long)std::floor(zStart / a) - 1;
       sites.clear();
       for (long long kx = (long long)std::floor(cx0 / a) - 1; kx <= (long long)std::ceil(cx1 / a); ++kx)
-        for (long long ky = (long long)std::floor(cy0 / a) - 1; ky <= (long long)std::ceil(cy1 / a); ++ky)
+        for (long long ky = (long long)std::floor(cy0 / a) - 1; ky <= (long long)std::ceil(cy1 / a); ++ky) {
+          // Which basis sites of this (kx, ky) column lie in the vertex's cell column: (x, y) does not depend
+          // on kz, so the test is made once, not for each of the 64 layers (the same sites in the same order).
+          unsigned inColumn = 0;
+          for (unsigned bi = 0; bi < 4; ++bi) {
+            const Real u = (Real(kx) + basis[bi][0]) * a, w = (Real(ky) + basis[bi][1]) * a;
+            if (u >= cx0 && u < cx1 && w >= cy0 && w < cy1) inColumn |= 1u << bi;
+          }
+          if (inColumn == 0) continue;
           for (long long kz = kz0; kz < kz0 + 64; ++kz)
-            for (const auto& b : basis) {
+            for (unsigned bi = 0; bi < 4; ++bi) {
+              if (!(inColumn >> bi & 1u)) continue;
+              const auto& b = basis[bi];
               const Real u = (Real(kx) + b[0]) * a, w = (Real(ky) + b[1]) * a;
-              if (!(u >= cx0 && u < cx1 && w >= cy0 && w < cy1)) continue;
               const Vec3 p(x0 + u, y0 + w, (Real(kz) + b[2]) * a);
               const Real above = (p - planePoint).dot(s.upL);
               if (!(above >= r) || !(above <= s.cap) || !(p.z() >= h + r)) continue;
@@ -492,6 +501,7 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
               }
               sites.push_back({above, p});
             }
+        }
       std::sort(sites.begin(), sites.end(), [](const Site& l, const Site& rr) {
         return l.above < rr.above || (l.above == rr.above && l.p.z() < rr.p.z());
       });
