@@ -482,13 +482,24 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
       const Vec3 p = T.applyInverse(pw);
       grid.insert(keyOf(p), p);
     }
+  // Within reach: |q - p| < dFree, decided as before (the square root of the squared norm against dFree); the
+  // squared norm settles all but the pairs within 1e-12 of the bound without the square root (most points of
+  // the 27 cubes are well outside it).
+  const Real dFree = d * (1 - 1e-9);
+  const Real dFree2Lo = dFree * dFree * (1 - 1e-12), dFree2Hi = dFree * dFree * (1 + 1e-12);
+  auto within = [&](const Vec3& q, const Vec3& p) {
+    const Real s2 = (q - p).squaredNorm();
+    if (s2 >= dFree2Hi) return false;
+    if (s2 < dFree2Lo) return true;
+    return std::sqrt(s2) < dFree;
+  };
   auto free = [&](const Vec3& p) {
     const CellKey k = keyOf(p);
     for (long long dz = -1; dz <= 1; ++dz)
       for (long long dy = -1; dy <= 1; ++dy)
         for (long long dx = -1; dx <= 1; ++dx) {
           if (!grid.forEach(CellKey{k.x + dx, k.y + dy, k.z + dz},
-                            [&](const Vec3& q) { return !((q - p).norm() < d * (1 - 1e-9)); }))
+                            [&](const Vec3& q) { return !within(q, p); }))
             return false;
         }
     return true;
