@@ -485,7 +485,22 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
       const uint32_t k0 = m.pairStart[i], k1 = m.pairStart[i + 1];
       if (k0 == k1) continue;
       // Order this particle's contacts by partner so the list does not depend on the hash layout.
-      std::sort(m.pairB.begin() + k0, m.pairB.begin() + k1);
+      // A particle has a handful of partners: an insertion sort (std::sort's set-up cost more than the sort;
+      // the partners are distinct, so the order is the same).
+      if (k1 - k0 <= 24) {
+        uint32_t* pb = m.pairB.data();
+        for (uint32_t k = k0 + 1; k < k1; ++k) {
+          const uint32_t val = pb[k];
+          uint32_t q = k;
+          while (q > k0 && pb[q - 1] > val) {
+            pb[q] = pb[q - 1];
+            --q;
+          }
+          pb[q] = val;
+        }
+      } else {
+        std::sort(m.pairB.begin() + k0, m.pairB.begin() + k1);
+      }
       const Vec3 xi = x[i];
       const Real ri = r[i];
       for (uint32_t k = k0; k < k1; ++k) {
