@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -50,6 +51,15 @@ TEST_SUITE("granular") {
     // (the carried soil: the median velocity is theirs, most of them are slow against it), 600 at rest beside it
     // touching its side (fast against the median: h |v - u| = 6.7 mm, above a quarter radius), 150 fast ones
     // at 0.5-3 m/s in random directions through both; each kind meets each kind.
+    // Run twice (doctest subcases): with the four-wide candidate filter (header, "Candidate filter") where the
+    // CPU has AVX2, and with the scalar test alone; both must equal the brute force in every step.
+    bool filter = true;
+    SUBCASE("four-wide candidate filter on") { filter = true; }
+    SUBCASE("candidate filter off (scalar test only)") { filter = false; }
+    detail::ParticleCollider::setPairFilterEnabled(filter);
+    const bool expectFilter = filter && detail::ParticleCollider::pairFilterAvailable();
+    MESSAGE((expectFilter ? std::string("candidate filter on") : std::string("candidate filter off")));
+    size_t stepsFiltered = 0;
     const Real h = 1.0 / 60;
     GranularBodySystem ps;
     Rng rng{2026};
@@ -93,6 +103,7 @@ TEST_SUITE("granular") {
       const Pairs expected = bruteForce(ps, h, collider.getContactMargin());
       INFO("step " << step << ": " << collider.getNumFastParticles() << " fast of " << ps.numParticles());
       REQUIRE(found == expected);
+      if (collider.usedPairFilter()) ++stepsFiltered;
       pairsChecked += expected.size();
       const size_t fast = collider.getNumFastParticles();
       fastMin = std::min(fastMin, fast);
@@ -117,5 +128,10 @@ TEST_SUITE("granular") {
     CHECK(stepsWithBoth == 40);
     CHECK(fastMin > 100);
     CHECK(hashedChecked);
+    // The filter runs on the dense grid only: in the first 7 steps here (then the flung particles' box grows past
+    // the dense grid's size limit and the hashed grid takes over), never when off.
+    if (expectFilter) CHECK(stepsFiltered >= 5);
+    else CHECK(stepsFiltered == 0);
+    detail::ParticleCollider::setPairFilterEnabled(true);
   }
 }

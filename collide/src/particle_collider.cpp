@@ -6,6 +6,11 @@
 #include <climits>
 #include <cmath>
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define SCREE_PAIR_AVX2 1
+#endif
+
 #include "scree/collide/narrowphase.h"
 #include "scree/collide/shapes.h"
 #include "scree/core/rigid_body.h"
@@ -35,6 +40,45 @@ constexpr Real kSlowShare = 0.25;
 #define SCREE_PAIR_INLINE __attribute__((always_inline))
 #else
 #define SCREE_PAIR_INLINE
+#endif
+
+// ---- Four-wide candidate filter (see "Candidate filter" in the header) ------------------------------------------
+// The pair search's cheap reject, four candidates at a time in 256-bit AVX2 registers, over the structure-of-
+// arrays copy of the sorted entries: bit l of the result is set unless candidate k0 + l is certainly rejected,
+// i.e. unless dist2 >= far^2 (1 + 1e-12) with
+//   dist2 = (dx^2 + dy^2) + dz^2   (Eigen's order for a 3-vector's squaredNorm),
+//   far   = (r_i + r_j) + min((w_i + w_j) + margin, reach),
+// the scalar test's operations in its order (no FMA: the function is compiled for AVX2 only). The 1e-12 makes
+// the filter conservative even if one of these roundings differed: every candidate it keeps still goes through
+// the scalar test, which alone decides, so the pairs found are the scalar search's whatever the filter does.
+// A NaN distance is kept (the scalar test's comparison is false for it too). At most 64 candidates per call.
+#ifdef SCREE_PAIR_AVX2
+__attribute__((target("avx2"))) uint64_t pairFilterAvx2(const double* sx, const double* sy, const double* sz,
+                                                        const double* sr, const double* sw, uint32_t k0,
+                                                        uint32_t count, double xi, double yi, double zi, double ri,
+                                                        double wi, double margin, double reach) {
+  const __m256d vx = _mm256_set1_pd(xi), vy = _mm256_set1_pd(yi), vz = _mm256_set1_pd(zi);
+  const __m256d vr = _mm256_set1_pd(ri), vw = _mm256_set1_pd(wi), vm = _mm256_set1_pd(margin);
+  const __m256d vreach = _mm256_set1_pd(reach), slack = _mm256_set1_pd(1 + 1e-12);
+  uint64_t keep = 0;
+  for (uint32_t l = 0; l < count; l += 4) {
+    const uint32_t k = k0 + l;
+    const __m256d dx = _mm256_sub_pd(vx, _mm256_loadu_pd(sx + k));
+    const __m256d dy = _mm256_sub_pd(vy, _mm256_loadu_pd(sy + k));
+    const __m256d dz = _mm256_sub_pd(vz, _mm256_loadu_pd(sz + k));
+    const __m256d d2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
+                                     _mm256_mul_pd(dz, dz));
+    const __m256d rr = _mm256_add_pd(vr, _mm256_loadu_pd(sr + k));
+    const __m256d ww = _mm256_add_pd(_mm256_add_pd(vw, _mm256_loadu_pd(sw + k)), vm);
+    const __m256d far = _mm256_add_pd(rr, _mm256_min_pd(ww, vreach));
+    const __m256d lim = _mm256_mul_pd(_mm256_mul_pd(far, far), slack);
+    // Not (d2 >= lim), true for NaN: kept.
+    const unsigned bits = unsigned(_mm256_movemask_pd(_mm256_cmp_pd(d2, lim, _CMP_NGE_UQ)));
+    keep |= uint64_t(bits) << l;
+  }
+  // Lanes past the run (they read the next entries or the arrays' padding) are dropped.
+  return count >= 64 ? keep : keep & ((uint64_t(1) << count) - 1);
+}
 #endif
 
 // Cell coordinate of a position component; clamped so that a particle far away (1e9 cells) cannot overflow
@@ -80,6 +124,10 @@ struct ParticleCollider::Impl {
     uint32_t fast;  // 1: searches its own partners (w_j > the slow bound)
   };
   std::vector<Entry> entries;               // [sorted.size()]
+  // The entries' centres, radii and speed bounds as structure of arrays for the four-wide candidate filter,
+  // [sorted.size() + 4]: the filter's last load of a run may read up to three entries past it.
+  std::vector<double> sx, sy, sz, sr, sw;
+  bool usedFilter = false;  // the last collide() ran the four-wide filter
   std::vector<std::vector<ParticleContact>> chunkOut;  // per chunk
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> chunkPairs;  // per chunk: pairs (lower, higher) found
   std::vector<uint32_t> pairStart;  // [size() + 1] first pair of each lower particle in pairB
@@ -129,10 +177,15 @@ ParticleCollider::~ParticleCollider() = default;
 
 void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<GeometryRef>& geometries, Real h) {
   Impl& m = *impl_;
-  pp_.clear();
+  // pp_ keeps last step's elements until its resize below: every element is then overwritten whole, so growing
+  // it value-initialises only the new tail (clearing it here made the resize value-initialise all ~25,000
+  // contacts, 4 MB written twice per step).
   pg_.clear();
   const size_t n = ps.size();
-  if (n == 0) return;
+  if (n == 0) {
+    pp_.clear();
+    return;
+  }
   const auto& x = ps.positions();
   const auto& v = ps.velocities();
   const auto& r = ps.radii();
@@ -221,6 +274,10 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
 #pragma omp parallel for schedule(static) if (n >= kParallelChunks * kChunk)
     for (size_t i = 0; i < n; ++i) m.bucketOf[i] = uint32_t(hashCell(m.cx[i], m.cy[i], m.cz[i]) & m.tableMask);
   }
+  // The four-wide candidate filter runs on the dense grid's runs (the hashed grid, a rare fallback, keeps the
+  // scalar test alone).
+  const bool useFilter = m.dense && pairFilterActive();
+  m.usedFilter = useFilter;
   m.bucketStart.assign(table + 1, 0);
   for (size_t i = 0; i < n; ++i)
     if (ps.isAliveDense(i)) ++m.bucketStart[m.bucketOf[i] + 1];
@@ -233,11 +290,21 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
     for (size_t i = 0; i < n; ++i)
       if (ps.isAliveDense(i)) m.sorted[fill[m.bucketOf[i]]++] = uint32_t(i);
     m.entries.resize(m.sorted.size());
+    if (useFilter) {
+      for (auto* a : {&m.sx, &m.sy, &m.sz, &m.sr, &m.sw}) a->assign(m.sorted.size() + 4, 0.0);
+    }
     for (size_t k = 0; k < m.sorted.size(); ++k) {
       const uint32_t j = m.sorted[k];
       const uint32_t fast = twoSpeed && m.w[j] > slowW ? 1u : 0u;
       m.entries[k] = {x[j], r[j], m.w[j], m.cx[j], m.cy[j], m.cz[j], j, fast};
       if (m.dense) m.posOf[j] = uint32_t(k);
+      if (useFilter) {
+        m.sx[k] = x[j].x();
+        m.sy[k] = x[j].y();
+        m.sz[k] = x[j].z();
+        m.sr[k] = r[j];
+        m.sw[k] = m.w[j];
+      }
     }
     for (size_t i = 0; i < n; ++i)
       if (twoSpeed && ps.isAliveDense(i) && m.w[i] > slowW) m.fastList.push_back(uint32_t(i));
@@ -283,6 +350,25 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
         if (dist2 >= lim * lim) return;
         out.push_back(j > i ? std::make_pair(uint32_t(i), j) : std::make_pair(j, uint32_t(i)));
       };
+      // Calls f(entry) for the run [k0, k1) of the sorted entries: all of them, or (the four-wide filter on)
+      // only those the cheap reject does not certainly drop. f makes the full test either way.
+      auto scanRun = [&](uint32_t k0, uint32_t k1, auto&& f) SCREE_PAIR_INLINE {
+#ifdef SCREE_PAIR_AVX2
+        if (useFilter) {
+          for (uint32_t b0 = k0; b0 < k1; b0 += 64) {
+            const uint32_t count = std::min<uint32_t>(64, k1 - b0);
+            uint64_t keep = pairFilterAvx2(m.sx.data(), m.sy.data(), m.sz.data(), m.sr.data(), m.sw.data(), b0,
+                                           count, xi.x(), xi.y(), xi.z(), ri, wi, margin_, reach);
+            while (keep) {
+              f(m.entries[b0 + uint32_t(__builtin_ctzll(keep))]);
+              keep &= keep - 1;
+            }
+          }
+          return;
+        }
+#endif
+        for (uint32_t k = k0; k < k1; ++k) f(m.entries[k]);
+      };
       if (fastI) {
         auto take = [&](const Impl::Entry& e) SCREE_PAIR_INLINE {
           if (e.j == i) return;
@@ -316,7 +402,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
               if (qx0 > qx1) continue;
               const uint32_t k0 = m.bucketStart[size_t(m.denseCell(qx0, qy, qz))];
               const uint32_t k1 = m.bucketStart[size_t(m.denseCell(qx1, qy, qz)) + 1];
-              for (uint32_t k = k0; k < k1; ++k) take(m.entries[k]);
+              scanRun(k0, k1, take);
               continue;
             }
             for (int dx = x0; dx <= x1; ++dx) {
@@ -351,7 +437,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
         // (y-1..y+1, z+1), each from x-1 to x+1 trimmed by the same one-cell rule. A row is one contiguous run.
         const int64_t c = int64_t(m.bucketOf[i]);
         const uint32_t own1 = m.bucketStart[size_t(c) + (gap2[0][2] < 1 ? 2 : 1)];
-        for (uint32_t k = m.posOf[i] + 1; k < own1; ++k) takeSlow(m.entries[k]);
+        scanRun(m.posOf[i] + 1, own1, takeSlow);
         for (int dz = 0; dz <= 1; ++dz)
           for (int dy = dz == 0 ? 1 : -1; dy <= 1; ++dy) {
             const Real g = gap2[1][dy + 1] + gap2[2][dz + 1];
@@ -359,7 +445,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
             const int64_t row = c + dz * m.nxy + dy * m.nx;
             const uint32_t k0 = m.bucketStart[size_t(row + (g + gap2[0][0] < 1 ? -1 : 0))];
             const uint32_t k1 = m.bucketStart[size_t(row + (g + gap2[0][2] < 1 ? 2 : 1))];
-            for (uint32_t k = k0; k < k1; ++k) takeSlow(m.entries[k]);
+            scanRun(k0, k1, takeSlow);
           }
         continue;
       }
@@ -399,14 +485,30 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
       const uint32_t k0 = m.pairStart[i], k1 = m.pairStart[i + 1];
       if (k0 == k1) continue;
       // Order this particle's contacts by partner so the list does not depend on the hash layout.
-      std::sort(m.pairB.begin() + k0, m.pairB.begin() + k1);
+      // A particle has a handful of partners: an insertion sort (std::sort's set-up cost more than the sort;
+      // the partners are distinct, so the order is the same).
+      if (k1 - k0 <= 24) {
+        uint32_t* pb = m.pairB.data();
+        for (uint32_t k = k0 + 1; k < k1; ++k) {
+          const uint32_t val = pb[k];
+          uint32_t q = k;
+          while (q > k0 && pb[q - 1] > val) {
+            pb[q] = pb[q - 1];
+            --q;
+          }
+          pb[q] = val;
+        }
+      } else {
+        std::sort(m.pairB.begin() + k0, m.pairB.begin() + k1);
+      }
       const Vec3 xi = x[i];
       const Real ri = r[i];
       for (uint32_t k = k0; k < k1; ++k) {
         const uint32_t j = m.pairB[k];
         const Vec3 d = xi - x[j];
         const Real dist = std::sqrt(d.squaredNorm());
-        ParticleContact& pc = pp_[k];  // value-initialised by the resize (pp_ was cleared)
+        // Built whole and assigned: pp_[k] may hold last step's contact (and a listener's overrides).
+        ParticleContact pc;
         pc.a = uint32_t(i);
         pc.b = int32_t(j);
         // Coincident centres: any unit normal will do; pick +z so the result is deterministic.
@@ -414,6 +516,7 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
         pc.depth = ri + r[j] - dist;
         // Midway between the two surfaces.
         pc.point = xi - pc.normal * (ri - 0.5 * pc.depth);
+        pp_[k] = pc;
       }
     }
   }
@@ -504,6 +607,25 @@ void ParticleCollider::collide(const GranularBodySystem& ps, const std::vector<G
     for (size_t c = 0; c < numGChunks; ++c) pg_.insert(pg_.end(), m.chunkOut[c].begin(), m.chunkOut[c].end());
   }
 }
+
+// ---- four-wide candidate filter: switches (header, "Candidate filter") ----
+namespace {
+bool& pairFilterEnabled() {
+  static bool on = true;
+  return on;
+}
+}  // namespace
+bool ParticleCollider::pairFilterAvailable() {
+#ifdef SCREE_PAIR_AVX2
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+#else
+  return false;
+#endif
+}
+void ParticleCollider::setPairFilterEnabled(bool on) { pairFilterEnabled() = on; }
+bool ParticleCollider::pairFilterActive() { return pairFilterEnabled() && pairFilterAvailable(); }
+bool ParticleCollider::usedPairFilter() const { return impl_->usedFilter; }
 
 Real ParticleCollider::getCellSize() const { return impl_->cell; }
 size_t ParticleCollider::getNumFastParticles() const { return impl_->fastList.size(); }

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <unordered_map>
 
 #include "scree/core/errors.h"
 #include "scree/core/logger.h"
@@ -383,10 +382,62 @@ struct CellKey {
   long long x, y, z;
   bool operator==(const CellKey& o) const { return x == o.x && y == o.y && z == o.z; }
 };
-struct CellHash {
-  size_t operator()(const CellKey& k) const {
-    return size_t(k.x * 73856093LL) ^ size_t(k.y * 19349663LL) ^ size_t(k.z * 83492791LL);
+// The terrain particles near a footprint by lattice cube, for createParticles' "is this site free" test: an
+// open-addressing table of cubes (power-of-two size, linear probing, at most half full) whose slots head a
+// linked list of the cube's points. It replaced a std::unordered_map of vectors (a modulo by a prime and a
+// pointer chase per probe, 27 probes per site tested: most of createParticles' time). The test only asks
+// whether any point is within reach, so the container changes nothing in the result.
+class CubeGrid {
+ public:
+  explicit CubeGrid(size_t expected) {
+    size_t t = 64;
+    while (t < 2 * expected) t <<= 1;
+    rehash(t);
   }
+  void insert(const CellKey& k, const Vec3& p) {
+    if (2 * (used_ + 1) > keys_.size()) rehash(2 * keys_.size());
+    const size_t s = slot(k);
+    if (head_[s] < 0) {
+      keys_[s] = k;
+      ++used_;
+    }
+    pts_.push_back(p);
+    next_.push_back(head_[s]);
+    head_[s] = int32_t(pts_.size() - 1);
+  }
+  /// Calls f(point) for the cube's points until f returns false; returns false then.
+  template <class F>
+  bool forEach(const CellKey& k, F&& f) const {
+    for (int32_t e = head_[slot(k)]; e >= 0; e = next_[size_t(e)])
+      if (!f(pts_[size_t(e)])) return false;
+    return true;
+  }
+
+ private:
+  size_t slot(const CellKey& k) const {
+    const uint64_t h0 = uint64_t(k.x) * 73856093ull ^ uint64_t(k.y) * 19349663ull ^ uint64_t(k.z) * 83492791ull;
+    size_t s = size_t((h0 * 0x9e3779b97f4a7c15ull) >> 20) & mask_;
+    while (head_[s] >= 0 && !(keys_[s] == k)) s = (s + 1) & mask_;
+    return s;
+  }
+  void rehash(size_t t) {
+    std::vector<CellKey> oldKeys = std::move(keys_);
+    std::vector<int32_t> oldHead = std::move(head_);
+    keys_.assign(t, CellKey{0, 0, 0});
+    head_.assign(t, -1);
+    mask_ = t - 1;
+    for (size_t s = 0; s < oldKeys.size(); ++s)
+      if (oldHead[s] >= 0) {
+        const size_t n = slot(oldKeys[s]);
+        keys_[n] = oldKeys[s];
+        head_[n] = oldHead[s];
+      }
+  }
+  std::vector<CellKey> keys_;
+  std::vector<int32_t> head_;  // first point of the slot's cube, -1: empty slot
+  std::vector<Vec3> pts_;
+  std::vector<int32_t> next_;  // next point of the same cube, -1: last
+  size_t mask_ = 0, used_ = 0;
 };
 }  // namespace
 
@@ -407,14 +458,13 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
   const Real d = getParticleLatticeDistance(), a = kSqrt2 * d;
   const Real x0 = -0.5 * heightField_->getSizeX(), y0 = -0.5 * heightField_->getSizeY();
   // Terrain particles near the footprint, hashed by lattice cube (d < a: neighbours are in the 27 cubes).
-  std::unordered_map<CellKey, std::vector<Vec3>, CellHash> grid;
+  CubeGrid grid(particles_.size() / 4 + 16);
   auto keyOf = [&](const Vec3& p) {
     return CellKey{(long long)std::floor(p.x() / a), (long long)std::floor(p.y() / a), (long long)std::floor(p.z() / a)};
   };
   // Only particles that can be within d of a site: sites lie over the shovel's world box (x, y), so a particle
   // farther than d outside it in x or y never blocks one (most live particles, once a heap is dumped elsewhere).
   const Real reachXY = d;
-  grid.reserve(particles_.size() / 4 + 16);
   for (const auto& [id, vol] : particles_)
     if (gbs.isValid(id)) {
       const Vec3 pw = gbs.getPosition(id);
@@ -423,24 +473,34 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
         if (p.x() < siteRect[0] - reachXY || p.x() > siteRect[1] + reachXY || p.y() < siteRect[2] - reachXY ||
             p.y() > siteRect[3] + reachXY)
           continue;
-        grid[keyOf(p)].push_back(p);
+        grid.insert(keyOf(p), p);
         continue;
       }
       if (pw.x() < s.box.lo.x() - reachXY || pw.x() > s.box.hi.x() + reachXY || pw.y() < s.box.lo.y() - reachXY ||
           pw.y() > s.box.hi.y() + reachXY)
         continue;
       const Vec3 p = T.applyInverse(pw);
-      grid[keyOf(p)].push_back(p);
+      grid.insert(keyOf(p), p);
     }
+  // Within reach: |q - p| < dFree, decided as before (the square root of the squared norm against dFree); the
+  // squared norm settles all but the pairs within 1e-12 of the bound without the square root (most points of
+  // the 27 cubes are well outside it).
+  const Real dFree = d * (1 - 1e-9);
+  const Real dFree2Lo = dFree * dFree * (1 - 1e-12), dFree2Hi = dFree * dFree * (1 + 1e-12);
+  auto within = [&](const Vec3& q, const Vec3& p) {
+    const Real s2 = (q - p).squaredNorm();
+    if (s2 >= dFree2Hi) return false;
+    if (s2 < dFree2Lo) return true;
+    return std::sqrt(s2) < dFree;
+  };
   auto free = [&](const Vec3& p) {
     const CellKey k = keyOf(p);
     for (long long dz = -1; dz <= 1; ++dz)
       for (long long dy = -1; dy <= 1; ++dy)
         for (long long dx = -1; dx <= 1; ++dx) {
-          auto it = grid.find(CellKey{k.x + dx, k.y + dy, k.z + dz});
-          if (it == grid.end()) continue;
-          for (const Vec3& q : it->second)
-            if ((q - p).norm() < d * (1 - 1e-9)) return false;
+          if (!grid.forEach(CellKey{k.x + dx, k.y + dy, k.z + dz},
+                            [&](const Vec3& q) { return !within(q, p); }))
+            return false;
         }
     return true;
   };
@@ -464,11 +524,20 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
       const long long kz0 = (long long)std::floor(zStart / a) - 1;
       sites.clear();
       for (long long kx = (long long)std::floor(cx0 / a) - 1; kx <= (long long)std::ceil(cx1 / a); ++kx)
-        for (long long ky = (long long)std::floor(cy0 / a) - 1; ky <= (long long)std::ceil(cy1 / a); ++ky)
+        for (long long ky = (long long)std::floor(cy0 / a) - 1; ky <= (long long)std::ceil(cy1 / a); ++ky) {
+          // Which basis sites of this (kx, ky) column lie in the vertex's cell column: (x, y) does not depend
+          // on kz, so the test is made once, not for each of the 64 layers (the same sites in the same order).
+          unsigned inColumn = 0;
+          for (unsigned bi = 0; bi < 4; ++bi) {
+            const Real u = (Real(kx) + basis[bi][0]) * a, w = (Real(ky) + basis[bi][1]) * a;
+            if (u >= cx0 && u < cx1 && w >= cy0 && w < cy1) inColumn |= 1u << bi;
+          }
+          if (inColumn == 0) continue;
           for (long long kz = kz0; kz < kz0 + 64; ++kz)
-            for (const auto& b : basis) {
+            for (unsigned bi = 0; bi < 4; ++bi) {
+              if (!(inColumn >> bi & 1u)) continue;
+              const auto& b = basis[bi];
               const Real u = (Real(kx) + b[0]) * a, w = (Real(ky) + b[1]) * a;
-              if (!(u >= cx0 && u < cx1 && w >= cy0 && w < cy1)) continue;
               const Vec3 p(x0 + u, y0 + w, (Real(kz) + b[2]) * a);
               const Real above = (p - planePoint).dot(s.upL);
               if (!(above >= r) || !(above <= s.cap) || !(p.z() >= h + r)) continue;
@@ -492,6 +561,7 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
               }
               sites.push_back({above, p});
             }
+        }
       std::sort(sites.begin(), sites.end(), [](const Site& l, const Site& rr) {
         return l.above < rr.above || (l.above == rr.above && l.p.z() < rr.p.z());
       });
@@ -504,7 +574,7 @@ void Terrain::createParticles(const Shovel& s, size_t i0, size_t i1, size_t j0, 
         const size_t id = gbs.createParticle(pw, r, vel);
         gbs.setCustomReal(ParticleVolumeBuffer, id, V);
         particles_.emplace_back(id, V);
-        grid[keyOf(site.p)].push_back(site.p);
+        grid.insert(keyOf(site.p), site.p);
         pending_[v] -= V;
         ledger_.pending -= V;
         ledger_.particles += V;

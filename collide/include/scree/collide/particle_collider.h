@@ -83,6 +83,21 @@ class ParticleCollider {
   /// order), so neighbours in space are near in memory. Uses the grid of the last collide().
   std::vector<uint32_t> localityOrder(const GranularBodySystem& ps) const;
 
+  // ---- Candidate filter (issue 16, docs/terrain.md "Digging cost", eighth round) ----------------------------
+  // On the dense grid, each run of candidate entries first goes through a four-wide AVX2 version of the cheap
+  // reject (structure-of-arrays copy of the entries' centres, radii and speed bounds; the same operations in
+  // the same order, with a 1e-12 relative slack towards keeping), and only the kept candidates get the scalar
+  // test, which alone decides: the contact list is the same, bit for bit, with the filter on or off. Chosen at
+  // run time (__builtin_cpu_supports("avx2")); without AVX2 every candidate gets the scalar test.
+  /// True when the CPU has AVX2 (and the build targets x86-64 with GCC or Clang).
+  static bool pairFilterAvailable();
+  /// Test and measurement switch (process-wide; default true). Off: every candidate gets the scalar test.
+  static void setPairFilterEnabled(bool on);
+  /// Enabled and available.
+  static bool pairFilterActive();
+  /// The last collide() ran the filter (a test's evidence).
+  bool usedPairFilter() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
