@@ -57,6 +57,15 @@ class Space {
   /// Number of candidate pairs from the broadphase in the last collide().
   size_t getNumBroadphasePairs() const { return numPairs_; }
 
+  // ---- issue 18 (persistent box-box manifolds; docs/solver-internals.md "Persistent box-box manifolds") ----
+  /// Reuse a box-box pair's manifold while the pair's relative pose stays within a small tolerance of the pose
+  /// it was clipped at (default on). The points are kept in the boxes' own frames and their depths recomputed
+  /// from the current poses every step; see space.cpp for the tolerance and the error it allows.
+  void setUsePersistentManifolds(bool on) { persistentManifolds_ = on; }
+  bool getUsePersistentManifolds() const { return persistentManifolds_; }
+  /// Box-box pairs whose manifold was reused (not clipped again) in the last collide().
+  size_t getNumReusedManifolds() const { return numReused_; }
+
  private:
   static uint64_t pairKey(uint32_t a, uint32_t b) {
     return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
@@ -85,6 +94,28 @@ class Space {
   // ---- issue 18 (fixed cost of small scenes): the serial narrowphase's one scratch buffer, whose storage is
   // swapped into each touching pair's contact (space.cpp) ----
   std::vector<ContactPoint> serialScratch_;
+  // ---- issue 18 (persistent box-box manifolds, space.cpp): one record per candidate pair of this step (count 0:
+  // none), the last step's records and their (pair key, slot) index sorted by key ----
+  struct CachedManifold {
+    const Shape* s0 = nullptr;
+    const Shape* s1 = nullptr;
+    Vec3 h0, h1;     // half extents when clipped
+    Transform rel;   // geometry 1 in geometry 0's frame when clipped
+    Vec3 n0;         // normal (from 1 towards 0) in geometry 0's frame
+    Vec3 p0[4], p1[4];  // each point on geometry 0's / 1's surface, in that geometry's frame
+    uint32_t fid[4];
+    uint64_t key = 0;   // (geometry 0 id << 32) | geometry 1 id
+    uint32_t count = 0;
+    bool reused = false;  // this step's points came from the last step's record
+  };
+  std::vector<CachedManifold> manifolds_, lastManifolds_;
+  std::vector<std::pair<uint64_t, uint32_t>> manifoldKeys_;
+  bool reuseManifold(const Geometry& g0, const Geometry& g1, Real margin, CachedManifold& rec,
+                     std::vector<ContactPoint>& points) const;
+  void recordManifold(const Geometry& g0, const Geometry& g1, const std::vector<ContactPoint>& points,
+                      CachedManifold& rec) const;
+  bool persistentManifolds_ = true;
+  size_t numReused_ = 0;
 };
 
 }  // namespace scree
