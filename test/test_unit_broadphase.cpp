@@ -314,3 +314,114 @@ TEST_CASE("space grows AABBs by the speculative margin of fast bodies") {
 }
 
 }  // TEST_SUITE
+
+// ---- issue 18: persistent box-box manifolds (Space::setUsePersistentManifolds, space.cpp) ----------------------
+// A box tilted on a larger box, in two spaces: `cached` (the default, manifolds reused) and `fresh` (every pair
+// clipped). Within the reuse tolerance (|dp| <= 1e-4 r, |dtheta| <= 1e-4 rad of the pose at the clip, r the larger
+// half diagonal) the cached contacts must lie within the error space.cpp derives -- a point off by at most
+// 2e-4 r, the depth exact for the body-fixed points, so off from the fresh clip's by that times the faces'
+// tilt plus the roundoff -- and keep the clip's feature ids; past the tolerance, after a change of extents or
+// with the option off, the pair is clipped again and the contacts equal the fresh clip's bit for bit.
+TEST_CASE("persistent box-box manifolds stay within their tolerance of a fresh clip and re-clip past it") {
+  struct Pair {
+    std::shared_ptr<Box> lowerShape = std::make_shared<Box>(Vec3(1.0, 0.8, 0.5));
+    std::shared_ptr<Box> upperShape = std::make_shared<Box>(Vec3(0.4, 0.3, 0.25));
+    GeometryRef lower = std::make_shared<Geometry>(lowerShape), upper = std::make_shared<Geometry>(upperShape);
+    RigidBodyRef body = std::make_shared<RigidBody>();
+    Space space;
+    std::vector<GeometryContact> out;
+    Pair() {
+      body->add(upper);
+      space.add(lower);
+      space.add(upper);
+    }
+    void place(const Vec3& p, const Quat& q) {
+      body->setPosition(p);
+      body->setRotation(q);
+    }
+  };
+  Pair cached, fresh;
+  fresh.space.setUsePersistentManifolds(false);
+  CHECK(cached.space.getUsePersistentManifolds());
+  const Real r = std::max(Vec3(1.0, 0.8, 0.5).norm(), Vec3(0.4, 0.3, 0.25).norm());
+  // Upper box resting 1 mm deep and tilted 0.002 rad about x: a face contact whose four points have different
+  // depths (the tilt makes the depth sensitive to where the point lies).
+  const Quat q0(Eigen::AngleAxis<Real>(0.002, Vec3(1, 0, 0)));
+  const Vec3 p0(0.1, -0.05, 0.5 + 0.25 - 1e-3);
+  auto both = [&](const Vec3& p, const Quat& q) {
+    cached.place(p, q);
+    fresh.place(p, q);
+    cached.space.collide(1.0 / 60, cached.out);
+    fresh.space.collide(1.0 / 60, fresh.out);
+    REQUIRE(cached.out.size() == 1);
+    REQUIRE(fresh.out.size() == 1);
+  };
+  auto same = [&] {
+    const auto& a = cached.out[0].points();
+    const auto& b = fresh.out[0].points();
+    REQUIRE(a.size() == b.size());
+    for (size_t k = 0; k < a.size(); ++k) {
+      CHECK(a[k].point == b[k].point);
+      CHECK(a[k].normal == b[k].normal);
+      CHECK(a[k].depth == b[k].depth);
+      CHECK(a[k].featureId == b[k].featureId);
+    }
+  };
+  both(p0, q0);
+  CHECK(cached.space.getNumReusedManifolds() == 0);
+  REQUIRE(cached.out[0].points().size() >= 3);
+  same();
+  std::vector<Real> clipDepths;
+  for (const ContactPoint& c : cached.out[0].points()) clipDepths.push_back(c.depth);
+
+  // Within the tolerance: 0.6e-4 r of translation and 0.6e-4 rad of rotation from the clip's pose.
+  const Vec3 dp = Vec3(0.6, -0.3, 0.2).normalized() * (0.6e-4 * r);
+  const Quat q1 = Quat(Eigen::AngleAxis<Real>(0.6e-4, Vec3(0.3, 1, 0.2).normalized())) * q0;
+  both(p0 + dp, q1);
+  CHECK(cached.space.getNumReusedManifolds() == 1);
+  {
+    const auto& a = cached.out[0].points();
+    const auto& b = fresh.out[0].points();
+    REQUIRE(a.size() == b.size());
+    const Real tilt = 0.002 + 0.6e-4;  // relative tilt of the two faces
+    for (size_t k = 0; k < a.size(); ++k) {
+      CAPTURE(k);
+      CHECK(a[k].featureId == b[k].featureId);
+      CHECK((a[k].point - b[k].point).norm() <= 2e-4 * r + 1e-12);
+      CHECK(std::abs(a[k].depth - b[k].depth) <= 2e-4 * r * tilt + 1e-12);
+      CHECK((a[k].normal - b[k].normal).norm() <= 1e-4 + 1e-12);
+    }
+    // The reuse is not a copy of the clip's answer: the depths moved with the bodies.
+    Real moved = 0;
+    for (size_t k = 0; k < a.size(); ++k) moved = std::max(moved, std::abs(a[k].depth - clipDepths[k]));
+    CHECK(moved > 1e-6);  // dp has a normal component of about 1.4e-5 m
+  }
+
+  // Past the tolerance (1.2e-4 r from the clip's pose, though only 0.6e-4 r from the last step's): clipped again.
+  both(p0 + 2 * dp, q0);
+  CHECK(cached.space.getNumReusedManifolds() == 0);
+  same();
+  both(p0 + 2 * dp, q0);  // unchanged pose: reused, and then the points are exactly the clip's
+  CHECK(cached.space.getNumReusedManifolds() == 1);
+  {
+    const auto& a = cached.out[0].points();
+    const auto& b = fresh.out[0].points();
+    for (size_t k = 0; k < a.size(); ++k) {
+      CHECK((a[k].point - b[k].point).norm() <= 1e-12);
+      CHECK(std::abs(a[k].depth - b[k].depth) <= 1e-12);
+    }
+  }
+
+  // New extents at the same pose: clipped again.
+  cached.upperShape->setHalfExtents(Vec3(0.4, 0.3, 0.2505));
+  fresh.upperShape->setHalfExtents(Vec3(0.4, 0.3, 0.2505));
+  both(p0 + 2 * dp, q0);
+  CHECK(cached.space.getNumReusedManifolds() == 0);
+  same();
+
+  // Switched off: every step clips.
+  cached.space.setUsePersistentManifolds(false);
+  both(p0 + 2 * dp, q0);
+  CHECK(cached.space.getNumReusedManifolds() == 0);
+  same();
+}
