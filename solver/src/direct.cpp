@@ -76,6 +76,36 @@ struct DirectSolver::Impl {
   }
 };
 
+namespace {
+/// Symbolic analysis in the cheaper of two orderings: AMD with postordering (the constructor's setting) or the
+/// rows' own order. DESIGN (issue 18, chain20's cost; docs/solver-internals.md "Direct solve: natural ordering
+/// where it fills no more"): with any permutation CHOLMOD's simplicial factorisation first forms A(p,p) by two
+/// transposes (cholmod_ptranspose, cholmod_transpose_sym), on every factorisation. On a chain, a tree or a
+/// banded system the rows' own order fills no more than AMD, and then those transposes are pure overhead: on
+/// chain20 they were 16 % of the step's instructions (callgrind), the same as the factorisation itself. So the
+/// natural order is kept whenever its factorisation needs at most kNaturalSlack times AMD's flops (the analysis
+/// reports both; a transpose costs about one pass over A, a factorisation at least that). The choice is made
+/// when the pattern changes (the analysis is cached with it), and does not depend on the values.
+constexpr double kNaturalSlack = 1.25;
+cholmod_factor* analyzeCheapest(cholmod_sparse* A, cholmod_common& cm) {
+  const int ordering = cm.method[0].ordering, postorder = cm.postorder;
+  cm.method[0].ordering = CHOLMOD_NATURAL;
+  cm.postorder = 0;
+  cholmod_factor* natural = cholmod_analyze(A, &cm);
+  const double flNatural = natural && cm.status == CHOLMOD_OK ? cm.fl : -1;
+  cm.method[0].ordering = ordering;
+  cm.postorder = postorder;
+  cholmod_factor* amd = cholmod_analyze(A, &cm);
+  const double flAmd = amd && cm.status == CHOLMOD_OK ? cm.fl : -1;
+  if (natural && flNatural >= 0 && (flAmd < 0 || flNatural <= kNaturalSlack * flAmd)) {
+    if (amd) cholmod_free_factor(&amd, &cm);
+    return natural;
+  }
+  if (natural) cholmod_free_factor(&natural, &cm);
+  return amd;
+}
+}  // namespace
+
 DirectSolver::DirectSolver() : impl_(std::make_unique<Impl>()) {}
 DirectSolver::~DirectSolver() = default;
 bool DirectSolver::available() { return true; }
@@ -295,7 +325,7 @@ DirectSolver::Result DirectSolver::solve(std::vector<ConstraintRow>& rows, const
     m.cm.supernodal = kkt ? CHOLMOD_SIMPLICIAL : CHOLMOD_AUTO;
     m.cm.final_ll = kkt ? 0 : 1;
     std::copy(m.x0.begin(), m.x0.end(), Ax);
-    fc.L = cholmod_analyze(A, &m.cm);
+    fc.L = analyzeCheapest(A, m.cm);
     fc.p = m.p;
     fc.i = m.i;
     res.symbolicAnalyses = 1;
