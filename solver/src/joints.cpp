@@ -70,6 +70,17 @@ Joint::FrameState Joint::state() const {
   return f;
 }
 
+Joint::FrameState Joint::anchors() const {
+  FrameState f;
+  const RigidBody* b0 = getBodyAt(0);
+  const RigidBody* b1 = getBodyAt(1);
+  f.pA = b0 ? b0->getTransform().apply(att_[0].point) : att_[0].point;
+  f.pB = b1 ? b1->getTransform().apply(att_[1].point) : att_[1].point;
+  f.rA = f.pA - a_->getCmPosition();
+  f.rB = b_ ? Vec3(f.pB - b_->getCmPosition()) : Vec3::Zero();
+  return f;
+}
+
 Real Joint::slidePosition() const {
   const FrameState f = state();
   return f.RB.col(2).dot(f.pA - f.pB);
@@ -270,7 +281,9 @@ BallJoint::BallJoint(RigidBodyRef a, RigidBodyRef b, const Vec3& worldPoint)
     : Joint(std::move(a), std::move(b), worldPoint, Quat::Identity(), NUM_DOFS, "BallJoint") {}
 
 void BallJoint::addRows(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& outDofs) {
-  const FrameState f = state();
+  // Issue 18 (chain20's row cost): the rows need the anchors only; state()'s two frame rotations (quaternion
+  // products and rotation matrices) were a third of this function's instructions.
+  const FrameState f = anchors();
   const Vec3 d = f.pA - f.pB;
   for (int k = 0; k < 3; ++k) {
     const Vec3 u = Vec3::Unit(k);

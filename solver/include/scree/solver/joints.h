@@ -53,6 +53,9 @@ class Joint : public Constraint {
     Quat qA, qB;
   };
   FrameState state() const;
+  /// state() without the frames' orientations (RA, RB, qA, qB left unset): the anchors and arms, the same values
+  /// bit for bit. For joints whose rows need no frame axes (BallJoint).
+  FrameState anchors() const;
   /// Holonomic row for `dof`: translational along u (world), angular about a (world), or a custom Jacobian.
   void pushLinear(const ConstraintContext& ctx, std::vector<detail::ConstraintRow>& rows, std::vector<int>& dofs, int dof,
                   const FrameState& f, const Vec3& u, Real g, Real compliance, Real damping) const;
