@@ -28,6 +28,9 @@
 // the particles' positions and velocities every 10 steps) and the created / merged totals: two builds whose
 // fingerprints match computed the same trench bit for bit (how the optimisations of docs/terrain.md, "Digging
 // cost", were checked). Hashing costs time: leave it unset for timings.
+// SCREE_DIG_SWEEP=scalar | avx2 picks the particle sweep's kernel (default: the widest the CPU has, AVX-512
+// where present); the results are the same bit for bit, only the time differs (a kernel's gain depends on the
+// CPU: docs/terrain.md, "Digging cost").
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -35,9 +38,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "cpu_time.h"
+#include "granular_stage.h"
 #include "scenes/terrain_dig.h"
 
 namespace {
@@ -56,6 +61,11 @@ double median(std::vector<double> v) {
 void BM_terrain_dig(benchmark::State& state) {
   const int threads = int(state.range(0));
   setNumThreads(threads);
+  if (const char* k = std::getenv("SCREE_DIG_SWEEP")) {
+    const std::string kernel(k);
+    scree::detail::GranularStage::setVectorSweepEnabled(kernel != "scalar");
+    scree::detail::GranularStage::setAvx512SweepEnabled(kernel != "scalar" && kernel != "avx2");
+  }
   for (auto _ : state) {
     state.PauseTiming();
     TerrainDigParams params;
