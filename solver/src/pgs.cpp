@@ -168,6 +168,8 @@ static bool solveClampedBlock(ConstraintRow* R, int n, const Real* resid, Real* 
 // The block's coordinates: D(0, i) = 1, D(1, i) = u_i, D(2, i) = v_i.
 static inline Real blockD(const ConstraintRow& r, int a) { return a == 0 ? 1.0 : a == 1 ? r.blockU : r.blockV; }
 
+static void factorBlock(const ConstraintRow* R, const PgsBlocks::Block& B, int cfg);
+
 // Builds the constant operators of the block whose first row is R (PgsBlocks::Block).
 static void buildBlock(const ConstraintRow* R, const std::vector<SolverBodyState>& bodies, PgsBlocks::Block& B) {
   const int n = R[0].blockCount;
@@ -199,8 +201,20 @@ static void buildBlock(const ConstraintRow* R, const std::vector<SolverBodyState
     B.wLinB[a] = bB.invMass * B.gLinB[a];
     B.wAngB[a] = bB.invInertia * B.gAngB[a];
   }
-  // S = D (K + E) D^T = G_a . W_c (over the free bodies) + sum_i D_ai e_i D_ci: the parts of body A, of body B
-  // and of E once (symmetric), then summed per configuration.
+  B.built[0] = B.built[1] = B.built[2] = false;
+  factorBlock(R, B, 0);
+}
+
+// S = D (K + E) D^T of configuration cfg (0: both bodies free, 1: A frozen, 2: B frozen) = G_a . W_c over the
+// free bodies + sum_i D_ai e_i D_ci, its Cholesky factor and inverse into B.sInv[cfg] and B.ok[cfg]. Only
+// configuration 0 is built with the block (the sweeps use it); the frozen ones only when the shock pass falls
+// back to sweeping a support (solvePreparedBlock), which most steps never do: building all three every step
+// was about a fifth of buildBlock's instructions on pyramid20 (issue 18). Each configuration is computed with
+// the same operations in the same order as when all three were built together, so the results are the same bits.
+static void factorBlock(const ConstraintRow* R, const PgsBlocks::Block& B, int cfg) {
+  const int n = R[0].blockCount;
+  const bool hasA = R[0].bodyA >= 0, hasB = R[0].bodyB >= 0;
+  // The parts of body A, of body B and of E once (symmetric), then summed for the configuration.
   Real SA[3][3], SB[3][3], SE[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   // E's part in one pass over the points (each entry summed in the points' order, as before).
   for (int i = 0; i < n; ++i) {
@@ -214,7 +228,7 @@ static void buildBlock(const ConstraintRow* R, const std::vector<SolverBodyState
       SB[a][c] = SB[c][a] = hasB ? B.gLinB[a].dot(B.wLinB[c]) + B.gAngB[a].dot(B.wAngB[c]) : 0.0;
       SE[c][a] = SE[a][c];
     }
-  for (int cfg = 0; cfg < 3; ++cfg) {
+  {
     const bool useA = cfg != 1, useB = cfg != 2;
     Real S[3][3];
     for (int a = 0; a < 3; ++a)
@@ -259,12 +273,14 @@ static void buildBlock(const ConstraintRow* R, const std::vector<SolverBodyState
     }
     B.ok[cfg] = ok;
   }
+  B.built[cfg] = true;
 }
 
 // The block update with the operators prepared in B (see solveNormalBlock below for the law).
 static bool solvePreparedBlock(ConstraintRow* R, const PgsBlocks::Block& B, std::vector<SolverBodyState>& bodies,
                                int frozen, Real& change) {
   const int cfg = frozen < 0 ? 0 : frozen == 0 ? 1 : 2;
+  if (!B.built[cfg]) factorBlock(R, B, cfg);
   if (!B.ok[cfg]) return false;
   const int n = R[0].blockCount;
   const int32_t ia = R[0].bodyA, ib = R[0].bodyB;

@@ -40,8 +40,11 @@ struct PgsBlocks {
     /// Inverse (symmetric, lower row-major packed: s00 s10 s11 s20 s21 s22) of D (K + E) D^T with both bodies
     /// free [0], body A frozen [1], body B frozen [2], from its Cholesky factor; ok[k] false when that system is
     /// not positive definite.
-    Real sInv[3][6];
-    bool ok[3];
+    /// Configuration 0 is built with the block; 1 and 2 on first use (built[k]), by the shock pass's fallback
+    /// sweeps, through a const block: mutable, and each block is only ever visited by one thread at a time.
+    mutable Real sInv[3][6];
+    mutable bool ok[3];
+    mutable bool built[3];
     bool axisU, axisV;
   };
   std::vector<Block> blocks;
