@@ -124,7 +124,20 @@ class WarmStartCache {
   void beginStore() { next_.clear(); }
   void add(const Entry& e) { next_.push_back(e); }
   void commit() {
-    std::sort(next_.begin(), next_.end());
+    // The entries arrive in contact order, which Space::collide sorts by geometry pair, i.e. by the key's first
+    // field: only each pair's few points need ordering by feature (insertion sort, stable). std::sort on all 80-
+    // byte entries was 1.1 % of pyramid20's step (issue 18). Whatever order they came in, the result is sorted.
+    for (size_t i = 1; i < next_.size(); ++i) {
+      if (!(next_[i] < next_[i - 1])) continue;
+      if (next_[i].pair != next_[i - 1].pair) {  // not in pair order: sort everything
+        std::sort(next_.begin(), next_.end());
+        break;
+      }
+      const Entry e = next_[i];
+      size_t j = i;
+      for (; j > 0 && e < next_[j - 1]; --j) next_[j] = next_[j - 1];
+      next_[j] = e;
+    }
     std::swap(current_, next_);
   }
 
