@@ -434,7 +434,12 @@ static bool solveNormalBlock(std::vector<ConstraintRow>& rows, std::vector<Solve
 }
 
 void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, PgsBlocks* blocks) {
-  for (ConstraintRow& r : rows) {
+  // One pass over the rows: each row's M^-1 J^T and diagonal, then its warm-start impulse (row order, as the
+  // sweeps' bodies expect; the blocks below read only masses and inertias, so building them afterwards gives the
+  // same bits). The rows are about 300 bytes each: a second pass cost pyramid20 about 1 % (issue 18).
+  if (blocks) blocks->starts.clear();
+  for (size_t i = 0; i < rows.size(); ++i) {
+    ConstraintRow& r = rows[i];
     SCREE_ASSERT(r.bodyA < int32_t(bodies.size()) && r.bodyB < int32_t(bodies.size()));
     SCREE_VALIDATE_CHECK(r.jLinA.allFinite() && r.jAngA.allFinite() && r.jLinB.allFinite() && r.jAngB.allFinite());
     const SolverBodyState& A = r.bodyA >= 0 ? bodies[r.bodyA] : kStatic;
@@ -449,26 +454,21 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     r.diag = k;
     r.invDiag = k > 0 ? 1.0 / k : 0.0;
     r.blockSlot = -1;
+    if (blocks && r.blockCount > 1 && r.blockBegin == int32_t(i)) blocks->starts.push_back(uint32_t(i));
+    if (r.lambda != 0) applyImpulse(r, r.lambda, bodies);
   }
   if (blocks) {
     // The compact manifold records (PgsSolver::iterate) describe last step's rows until iterate rebuilds them.
     blocks->manifolds.clear();
     blocks->points.clear();
     blocks->plan.clear();
-    size_t count = 0;
-    for (size_t i = 0; i < rows.size(); ++i)
-      if (rows[i].blockCount > 1 && rows[i].blockBegin == int32_t(i)) ++count;
+    const size_t count = blocks->starts.size();
     if (blocks->blocks.size() < count) blocks->blocks.resize(count);  // grows only: storage reused across steps
-    size_t slot = 0;
-    for (size_t i = 0; i < rows.size(); ++i)
-      if (rows[i].blockCount > 1 && rows[i].blockBegin == int32_t(i)) {
-        buildBlock(rows.data() + i, bodies, blocks->blocks[slot]);
-        rows[i].blockSlot = int32_t(slot++);
-      }
-  }
-  for (size_t i = 0; i < rows.size(); ++i) {
-    ConstraintRow& r = rows[i];
-    if (r.lambda != 0) applyImpulse(r, r.lambda, bodies);
+    for (size_t slot = 0; slot < count; ++slot) {
+      const uint32_t i = blocks->starts[slot];
+      buildBlock(rows.data() + i, bodies, blocks->blocks[slot]);
+      rows[i].blockSlot = int32_t(slot);
+    }
   }
 }
 

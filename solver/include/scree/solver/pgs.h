@@ -48,6 +48,7 @@ struct PgsBlocks {
     bool axisU, axisV;
   };
   std::vector<Block> blocks;
+  std::vector<uint32_t> starts;  ///< PgsSolver::prepare: each block's first row, in row order (slot order)
 
   // ---- issue 18 (compact contact arrays; pgs.cpp "Compact manifold sweeps", docs/solver-internals.md) ----
   /// A manifold contact (contact_rows.h: [t1, t2, twist][normal block]) swept as one unit: every datum a visit
