@@ -104,10 +104,18 @@ static bool solveClampedBlock(ConstraintRow* R, int n, const Real* resid, Real* 
                               std::vector<SolverBodyState>& bodies, Real& change) {
   bool active[kMaxNormalBlock];
   for (int i = 0; i < n; ++i) active[i] = true;
+  // K(i, j) = J_i M^-1 J_j^T (+ e_i on the diagonal), each entry formed once per call: the release rounds ask for
+  // the same entries again.
+  Real kCache[kMaxNormalBlock][kMaxNormalBlock];
+  uint32_t kHave[kMaxNormalBlock];
+  for (int i = 0; i < n; ++i) kHave[i] = 0;
   auto K = [&](int i, int j) {
+    if (kHave[i] >> j & 1u) return kCache[i][j];
     Real k = i == j ? R[i].e : 0.0;
     if (useA) k += R[i].jLinA.dot(R[j].mJLinA) + R[i].jAngA.dot(R[j].mJAngA);
     if (useB) k += R[i].jLinB.dot(R[j].mJLinB) + R[i].jAngB.dot(R[j].mJAngB);
+    kHave[i] |= 1u << j;
+    kCache[i][j] = k;
     return k;
   };
   for (int round = 0; round < n; ++round) {
@@ -128,18 +136,36 @@ static bool solveClampedBlock(ConstraintRow* R, int n, const Real* resid, Real* 
     }
     if (m > 3) return false;
     if (m > 0) {
-      Eigen::Matrix<Real, 3, 3> A = Eigen::Matrix<Real, 3, 3>::Identity();
-      Eigen::Matrix<Real, 3, 1> rhs = Eigen::Matrix<Real, 3, 1>::Zero();
+      // The active rows' K_AA + E_A (lower triangle) is symmetric positive definite for a regular block (e > 0):
+      // an unrolled Cholesky solve; a non-positive pivot (a singular block with e = 0) goes row by row.
+      Real L[3][3], rhs[3], x[3];
       for (int a = 0; a < m; ++a) {
         rhs[a] = resid[idx[a]];
         for (int i = 0; i < n; ++i)
           if (!active[i] && dl[i] != 0) rhs[a] -= K(idx[a], i) * dl[i];
-        for (int c = 0; c < m; ++c) A(a, c) = K(idx[a], idx[c]);
       }
-      const Eigen::LDLT<Eigen::Matrix<Real, 3, 3>> ldlt(A);
-      if (ldlt.info() != Eigen::Success) return false;
-      const Eigen::Matrix<Real, 3, 1> x = ldlt.solve(rhs);
-      if (!x.allFinite()) return false;
+      for (int j = 0; j < m; ++j) {
+        Real d = K(idx[j], idx[j]);
+        for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
+        if (!(d > 0)) return false;
+        L[j][j] = std::sqrt(d);
+        for (int i = j + 1; i < m; ++i) {
+          Real t = K(idx[i], idx[j]);
+          for (int k = 0; k < j; ++k) t -= L[i][k] * L[j][k];
+          L[i][j] = t / L[j][j];
+        }
+      }
+      for (int i = 0; i < m; ++i) {
+        Real t = rhs[i];
+        for (int k = 0; k < i; ++k) t -= L[i][k] * x[k];
+        x[i] = t / L[i][i];
+      }
+      for (int i = m; i-- > 0;) {
+        Real t = x[i];
+        for (int k = i + 1; k < m; ++k) t -= L[k][i] * x[k];
+        x[i] = t / L[i][i];
+      }
+      if (!std::isfinite(x[0] + (m > 1 ? x[1] : 0.0) + (m > 2 ? x[2] : 0.0))) return false;
       for (int a = 0; a < m; ++a) dl[idx[a]] = x[a];
     }
   }
