@@ -227,6 +227,14 @@ static void buildBlock(const ConstraintRow* R, const std::vector<SolverBodyState
     B.wLinB[a] = bB.invMass * B.gLinB[a];
     B.wAngB[a] = bB.invInertia * B.gAngB[a];
   }
+  // D E D^T, summed over the points in their order (the frozen configurations and the shock pass reuse it).
+  Real se[6] = {0, 0, 0, 0, 0, 0};
+  for (int i = 0; i < n; ++i) {
+    const Real D[3] = {1.0, R[i].blockU, R[i].blockV};
+    for (int a = 0, k = 0; a < 3; ++a)
+      for (int c = 0; c <= a; ++c, ++k) se[k] += D[a] * R[i].e * D[c];
+  }
+  for (int k = 0; k < 6; ++k) B.se[k] = se[k];
   B.built[0] = B.built[1] = B.built[2] = false;
   factorBlock(R, B, 0);
 }
@@ -238,18 +246,13 @@ static void buildBlock(const ConstraintRow* R, const std::vector<SolverBodyState
 // was about a fifth of buildBlock's instructions on pyramid20 (issue 18). Each configuration is computed with
 // the same operations in the same order as when all three were built together, so the results are the same bits.
 static void factorBlock(const ConstraintRow* R, const PgsBlocks::Block& B, int cfg) {
-  const int n = R[0].blockCount;
   const bool hasA = R[0].bodyA >= 0, hasB = R[0].bodyB >= 0;
   // The parts of body A, of body B and of E once (symmetric), then summed for the configuration.
-  Real SA[3][3], SB[3][3], SE[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-  // E's part in one pass over the points (each entry summed in the points' order, as before).
-  for (int i = 0; i < n; ++i) {
-    const Real D[3] = {1.0, R[i].blockU, R[i].blockV};
-    for (int a = 0; a < 3; ++a)
-      for (int c = 0; c <= a; ++c) SE[a][c] += D[a] * R[i].e * D[c];
-  }
-  for (int a = 0; a < 3; ++a)
-    for (int c = 0; c <= a; ++c) {
+  Real SA[3][3], SB[3][3], SE[3][3];
+  // E's part: buildBlock's sum over the points (B.se).
+  for (int a = 0, k = 0; a < 3; ++a)
+    for (int c = 0; c <= a; ++c, ++k) {
+      SE[a][c] = B.se[k];
       SA[a][c] = SA[c][a] = hasA ? B.gLinA[a].dot(B.wLinA[c]) + B.gAngA[a].dot(B.wAngA[c]) : 0.0;
       SB[a][c] = SB[c][a] = hasB ? B.gLinB[a].dot(B.wLinB[c]) + B.gAngB[a].dot(B.wAngB[c]) : 0.0;
       SE[c][a] = SE[a][c];
@@ -1138,15 +1141,15 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   for (int p = 0; p < 3; ++p)
     for (int q = 0; q <= p; ++q) K[kLinRow[p]][kLinRow[q]] += im * m.lin[p].dot(m.lin[q]);
   // Regularisation: the block's D E D^T, the friction rows' own e.
+  const Real* se = pb.blocks[m.block].se;  // D E D^T, packed lower (buildBlock)
+  for (int a = 0, k = 0; a < 3; ++a)
+    for (int c = 0; c <= a; ++c, ++k) K[a][c] += se[k];
   Real b[kM];
   for (int a = 0; a < 3; ++a) b[a] = m.dRhs[a];
   for (int i = 0; i < n; ++i) {
     const Real D[3] = {1.0, P[i].u, P[i].v};
-    const Real e = P[i].e, el = e * R[i].lambda;
-    for (int a = 0; a < 3; ++a) {
-      b[a] -= D[a] * el;
-      for (int c = 0; c <= a; ++c) K[a][c] += D[a] * e * D[c];
-    }
+    const Real el = P[i].e * R[i].lambda;
+    for (int a = 0; a < 3; ++a) b[a] -= D[a] * el;
   }
   for (int k = 0; k < 3; ++k) K[3 + k][3 + k] += m.e[k];
   // Residuals (velocities of both bodies, as in the sweeps).

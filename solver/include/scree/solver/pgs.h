@@ -37,6 +37,7 @@ struct PgsBlocks {
     Vec3 gLinA[3], gAngA[3], gLinB[3], gAngB[3];
     Vec3 wLinA[3], wAngA[3], wLinB[3], wAngB[3];
     Real dRhs[3];  ///< sum_i D_ai rhs_i
+    Real se[6];    ///< D E D^T = sum_i D_ai e_i D_ci, packed lower (s00 s10 s11 s20 s21 s22)
     /// Inverse (symmetric, lower row-major packed: s00 s10 s11 s20 s21 s22) of D (K + E) D^T with both bodies
     /// free [0], body A frozen [1], body B frozen [2], from its Cholesky factor; ok[k] false when that system is
     /// not positive definite.
