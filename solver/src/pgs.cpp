@@ -268,36 +268,37 @@ static void factorBlock(const ConstraintRow* R, const PgsBlocks::Block& B, int c
         for (int c = 0; c < 3; ++c) S[a][c] = S[c][a] = 0;
         S[a][a] = 1;
       }
-    Real L[6];
+    // S = L D L^T (unit lower L), then S^-1 = L^-T D^-1 L^-1 (packed lower, symmetric): a visit is then one
+    // 3 x 3 product, nine independent multiply-adds, instead of two triangular solves whose dependent divisions
+    // were the largest share of a visit (perf on pyramid20). L D L^T rather than Cholesky: the chain is three
+    // divisions, without Cholesky's three square roots (issue 18). A pivot that is not positive fails, as
+    // Cholesky's would.
     bool ok = S[0][0] > 0;
+    Real i0 = 0, i1 = 0, i2 = 0, l10 = 0, l20 = 0, l21 = 0;
     if (ok) {
-      L[0] = std::sqrt(S[0][0]);
-      L[1] = S[1][0] / L[0];
-      const Real p1 = S[1][1] - L[1] * L[1];
-      ok = p1 > 0;
+      i0 = 1 / S[0][0];
+      l10 = S[1][0] * i0;
+      l20 = S[2][0] * i0;
+      const Real d1 = S[1][1] - l10 * S[1][0];
+      ok = d1 > 0;
       if (ok) {
-        L[2] = std::sqrt(p1);
-        L[3] = S[2][0] / L[0];
-        L[4] = (S[2][1] - L[3] * L[1]) / L[2];
-        const Real p2 = S[2][2] - L[3] * L[3] - L[4] * L[4];
-        ok = p2 > 0;
-        if (ok) L[5] = std::sqrt(p2);
+        i1 = 1 / d1;
+        const Real u21 = S[2][1] - l20 * S[1][0];
+        l21 = u21 * i1;
+        const Real d2 = S[2][2] - l20 * S[2][0] - l21 * u21;
+        ok = d2 > 0;
+        if (ok) i2 = 1 / d2;
       }
     }
-    ok = ok && std::isfinite(L[0] + L[1] + L[2] + L[3] + L[4] + L[5]);
-    // S^-1 = L^-T L^-1 (packed lower, symmetric): a visit is then one 3 x 3 product, nine independent
-    // multiply-adds, instead of two triangular solves whose six dependent divisions were the largest share of
-    // a visit (perf on pyramid20).
     if (ok) {
-      const Real i0 = 1 / L[0], i2 = 1 / L[2], i5 = 1 / L[5];
-      const Real m10 = -L[1] * i0 * i2, m21 = -L[4] * i2 * i5, m20 = -(L[3] * i0 + L[4] * m10) * i5;
+      const Real m10 = -l10, m21 = -l21, m20 = l21 * l10 - l20;
       Real* Si = B.sInv[cfg];
-      Si[0] = i0 * i0 + m10 * m10 + m20 * m20;  // (0,0)
-      Si[1] = m10 * i2 + m20 * m21;              // (1,0)
-      Si[2] = i2 * i2 + m21 * m21;               // (1,1)
-      Si[3] = m20 * i5;                          // (2,0)
-      Si[4] = m21 * i5;                          // (2,1)
-      Si[5] = i5 * i5;                           // (2,2)
+      Si[0] = i0 + m10 * m10 * i1 + m20 * m20 * i2;  // (0,0)
+      Si[1] = m10 * i1 + m20 * m21 * i2;              // (1,0)
+      Si[2] = i1 + m21 * m21 * i2;                    // (1,1)
+      Si[3] = m20 * i2;                               // (2,0)
+      Si[4] = m21 * i2;                               // (2,1)
+      Si[5] = i2;                                     // (2,2)
       ok = std::isfinite(Si[0] + Si[1] + Si[2] + Si[3] + Si[4] + Si[5]);
     }
     B.ok[cfg] = ok;
@@ -1082,20 +1083,22 @@ bool PgsSolver::solveSupportExactly(std::vector<ConstraintRow>& rows, std::vecto
 // The support solve above on a compact manifold record (PgsSolver::iterate): the same system, its operators
 // read as 6-vectors, the impulses read from and written to the ConstraintRows (the shock pass's state).
 namespace {
-/// Solves K x = b for a symmetric positive definite 6 x 6 K (lower triangle read) by an unrolled Cholesky
+/// Solves K x = b for a symmetric positive definite 6 x 6 K (lower triangle read) by an unrolled L D L^T
 /// factorisation; false when a pivot is not positive (as Eigen::LLT reports). Written out because Eigen's
-/// general LLT was 0.39 M of pyramid20's 10.3 M instructions per step (one solve per shock support).
+/// general LLT was 0.39 M of pyramid20's 10.3 M instructions per step (one solve per shock support). L D L^T
+/// rather than Cholesky: the factorisation's critical path is then six divisions instead of six square roots
+/// followed by six divisions (the support solve was 11 % of pyramid20's step by perf samples; issue 18).
 bool choleskySolve6(const Real K[6][6], const Real b[6], Real x[6]) {
-  Real L[6][6], inv[6];
+  Real L[6][6], U[6][6], inv[6];  // U[i][k] = L[i][k] d_k
   for (int j = 0; j < 6; ++j) {
     Real d = K[j][j];
-    for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
+    for (int k = 0; k < j; ++k) d -= U[j][k] * L[j][k];
     if (!(d > 0)) return false;
-    const Real ljj = std::sqrt(d);
-    inv[j] = 1 / ljj;
+    inv[j] = 1 / d;
     for (int i = j + 1; i < 6; ++i) {
       Real s = K[i][j];
-      for (int k = 0; k < j; ++k) s -= L[i][k] * L[j][k];
+      for (int k = 0; k < j; ++k) s -= U[i][k] * L[j][k];
+      U[i][j] = s;
       L[i][j] = s * inv[j];
     }
   }
@@ -1103,12 +1106,12 @@ bool choleskySolve6(const Real K[6][6], const Real b[6], Real x[6]) {
   for (int i = 0; i < 6; ++i) {
     Real s = b[i];
     for (int k = 0; k < i; ++k) s -= L[i][k] * y[k];
-    y[i] = s * inv[i];
+    y[i] = s;
   }
   for (int i = 6; i-- > 0;) {
-    Real s = y[i];
+    Real s = y[i] * inv[i];
     for (int k = i + 1; k < 6; ++k) s -= L[k][i] * x[k];
-    x[i] = s * inv[i];
+    x[i] = s;
   }
   return std::isfinite(x[0] + x[1] + x[2] + x[3] + x[4] + x[5]);
 }
