@@ -121,8 +121,22 @@ void buildContactRows(SimulationState& s) {
         ++k;
       }
       rEff /= Real(nActive);
-      const Real theta = 0.5 * std::atan2(2 * b, a - cc);
-      const Vec3 e1 = std::cos(theta) * mt1 + std::sin(theta) * mt2, e2 = n0.cross(e1);
+      // The principal axis at theta = atan2(2b, a - cc) / 2, its cosine and sine from the double angle's by the
+      // half-angle formulas (the larger of the two by a square root, the other from sin 2theta = 2 sin cos):
+      // no atan2, sin or cos per manifold (libm's sincos was 1 % of pyramid20's step, issue 18).
+      const Real r2 = std::sqrt((a - cc) * (a - cc) + 4 * b * b);
+      Real ct = 1, st = 0;
+      if (r2 > 0) {
+        const Real c2 = (a - cc) / r2, s2 = 2 * b / r2;
+        if (c2 >= 0) {
+          ct = std::sqrt(0.5 * (1 + c2));
+          st = s2 / (2 * ct);
+        } else {
+          st = std::copysign(std::sqrt(0.5 * (1 - c2)), s2);
+          ct = s2 / (2 * st);
+        }
+      }
+      const Vec3 e1 = ct * mt1 + st * mt2, e2 = n0.cross(e1);
       Real su = 0, sv = 0;
       for (uint32_t i = 0; i < nActive; ++i) {
         blockU[i] = arm[i].dot(e1);
