@@ -1088,7 +1088,7 @@ namespace {
 /// general LLT was 0.39 M of pyramid20's 10.3 M instructions per step (one solve per shock support). L D L^T
 /// rather than Cholesky: the factorisation's critical path is then six divisions instead of six square roots
 /// followed by six divisions (the support solve was 11 % of pyramid20's step by perf samples; issue 18).
-bool choleskySolve6(const Real K[6][6], const Real b[6], Real x[6]) {
+bool ldltSolve6(const Real K[6][6], const Real b[6], Real x[6]) {
   Real L[6][6], U[6][6], inv[6];  // U[i][k] = L[i][k] d_k
   for (int j = 0; j < 6; ++j) {
     Real d = K[j][j];
@@ -1172,7 +1172,7 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
       b[a] = 0;
     }
   Real x[kM];
-  if (!choleskySolve6(K, b, x)) return false;
+  if (!ldltSolve6(K, b, x)) return false;
   // Bounds: the new normal impulses, then the friction inside mu times their new sum.
   Real nl[kMaxNormalBlock];
   Real sumN = 0;
