@@ -255,4 +255,31 @@ TEST_CASE("persistent team: every index once on its own thread, barrier order, n
   CHECK(total.load() == 800);  // every call's work done exactly once: 2 x 1 with the team, 1 x 2 without
 }
 
+TEST_CASE("persistent team: a lost wake-up costs at most the sleep bound, not a hang") {
+  // bench_rigid_stages BM_team_barrier hung about once in ten runs in a KVM guest: a thread asleep on the barrier's
+  // phase was never woken after the phase changed (core/src/parallel.cpp, sleepWhile). Every sleep is now bounded
+  // (1 ms inside a step). The test makes the lost wake-up certain: the value is stored with no wake at all, after
+  // the waiter has spun out and gone to sleep (50 ms later; its spin is 4000 loads and 4 yields). Without the bound
+  // the waiter sleeps for ever and ctest's timeout fails the test; with it, the waiter returns after the store.
+  // (The wait's length is not asserted: timing on a shared machine is the bench's business.)
+  std::atomic<uint32_t> value{0};
+  std::atomic<bool> returned{false};
+  std::thread waiter([&] {
+    detail::waitAtLeast(value, 1);
+    returned.store(true);
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  CHECK_FALSE(returned.load());  // the waiter waits while the value is short of its target
+  value.store(1, std::memory_order_release);  // deliberately no publish: no wake-up is sent
+  waiter.join();
+  CHECK(returned.load());
+  // The same for the barrier: the last arriver's wake is what the bound backs up; publish() wakes as before.
+  std::atomic<uint32_t> flag{0};
+  std::thread sleeper([&] { detail::waitAtLeast(flag, 3); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  detail::publish(flag, 3);
+  sleeper.join();
+  CHECK(flag.load() == 3);
+}
+
 }  // TEST_SUITE

@@ -1590,8 +1590,7 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
       for (size_t j = 0; j < list.size(); ++j) {
         waitAtLeast(done[other].v, wait[j]);
         shockRange(rows, bodies, ranges[list[j]], maxSweeps, blocks);
-        done[t].v.store(uint32_t(j + 1), std::memory_order_release);
-        done[t].v.notify_all();
+        publish(done[t].v, uint32_t(j + 1));
       }
     }
   });

@@ -54,6 +54,22 @@ constexpr int teamSpinCount() { return 4000; }
 /// Waits until `a` holds at least `target`: spins teamSpinCount() loads, then sleeps on the atomic.
 void waitAtLeast(const std::atomic<uint32_t>& a, uint32_t target);
 
+/// Stores `value` into `a` and wakes every thread sleeping on `a` (waitAtLeast, TeamBarrier, the team). Every
+/// store that a sleeping thread waits for goes through this (or publishAdd), never a bare store and notify.
+///
+/// DESIGN (a lost wake-up, found in December 2026): bench_rigid_stages BM_team_barrier hung in about one run in
+/// three in a KVM guest: both threads asleep in TeamBarrier::wait, one of them waiting for the phase before the
+/// current one, so its wake-up had been lost. Two fixes were measured and did not cure it: a sequentially
+/// consistent fence between the store and std::atomic::notify_all (libstdc++ 12 skips the wake when its count of
+/// sleepers reads zero, and the plain store and load around that check may be reordered on x86), and the futex
+/// system call directly with an unconditional wake (1 run in 12 still hung). The cause is not known. What holds
+/// is a bound on every sleep (core/src/parallel.cpp, sleepWhile: 1 ms inside a step, 20 ms for the idle worker),
+/// after which the sleeper looks at the value again: 14 of 14 runs passed, and test_unit_coloured_sweeps makes a
+/// lost wake-up certain and checks that the waiter still returns.
+void publish(std::atomic<uint32_t>& a, uint32_t value);
+/// Adds `delta` to `a` and wakes every thread sleeping on `a`.
+void publishAdd(std::atomic<uint32_t>& a, uint32_t delta);
+
 /// A reusable barrier for a team of n threads (phase counting), spinning then sleeping like the team.
 class TeamBarrier {
  public:
