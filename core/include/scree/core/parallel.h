@@ -33,8 +33,8 @@ namespace scree::detail {
 /// core its partner needs, and the partitioned pyramid20 step took 10-35 ms on two threads instead of 1.5 ms on
 /// one. Between jobs a worker spins for up to 2 ms, yielding every 256 loads (waking a sleeping worker through the
 /// futex cost about 0.2 ms in the KVM guest this was measured on, more than half the parallel work of a small
-/// scene's step), then sleeps on a futex (C++20 std::atomic::wait); the caller, the barrier and waitAtLeast spin
-/// `teamSpinCount()` loads, then sleep the same way. A fork-join to a spinning worker costs about 1 us
+/// scene's step), then sleeps on a futex for at most 20 ms at a time (see publish); the caller, the barrier and
+/// waitAtLeast spin `teamSpinCount()` loads, yield 4 times, then sleep for at most 1 ms at a time. A fork-join to a spinning worker costs about 1 us
 /// (bench_rigid_stages BM_team_fork_join).
 /// Called from inside a job, or while another thread of the program uses the team, the job runs once on the
 /// calling thread as job(ctx, 0, 1): a job must split its work by (t, n) and give the same result for any n (the
@@ -51,7 +51,8 @@ void runTeam(int n, F&& f) {
 /// Loads a waiting thread spins before it sleeps (team, TeamBarrier, waitAtLeast).
 constexpr int teamSpinCount() { return 4000; }
 
-/// Waits until `a` holds at least `target`: spins teamSpinCount() loads, then sleeps on the atomic.
+/// Waits until `a` holds at least `target`: spins teamSpinCount() loads, yields 4 times, then sleeps on the atomic
+/// for at most 1 ms at a time (see publish).
 void waitAtLeast(const std::atomic<uint32_t>& a, uint32_t target);
 
 /// Stores `value` into `a` and wakes every thread sleeping on `a` (waitAtLeast, TeamBarrier, the team). Every
