@@ -256,7 +256,7 @@ TEST_CASE("persistent team: every index once on its own thread, barrier order, n
 }
 
 TEST_CASE("persistent team: a lost wake-up costs at most the sleep bound, not a hang") {
-  // bench_rigid_stages BM_team_barrier hung about once in ten runs in a KVM guest: a thread asleep on the barrier's
+  // bench_rigid_stages BM_team_barrier hung in 3 of 13 runs in a KVM guest: a thread asleep on the barrier's
   // phase was never woken after the phase changed (core/src/parallel.cpp, sleepWhile). Every sleep is now bounded
   // (1 ms inside a step). The test makes the lost wake-up certain: the value is stored with no wake at all, after
   // the waiter has spun out and gone to sleep (50 ms later; its spin is 4000 loads and 4 yields). Without the bound
@@ -273,7 +273,7 @@ TEST_CASE("persistent team: a lost wake-up costs at most the sleep bound, not a 
   value.store(1, std::memory_order_release);  // deliberately no publish: no wake-up is sent
   waiter.join();
   CHECK(returned.load());
-  // The same for the barrier: the last arriver's wake is what the bound backs up; publish() wakes as before.
+  // And the normal path: a waiter asleep on a value that publish() changes returns.
   std::atomic<uint32_t> flag{0};
   std::thread sleeper([&] { detail::waitAtLeast(flag, 3); });
   std::this_thread::sleep_for(std::chrono::milliseconds(20));

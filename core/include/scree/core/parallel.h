@@ -34,8 +34,8 @@ namespace scree::detail {
 /// one. Between jobs a worker spins for up to 2 ms, yielding every 256 loads (waking a sleeping worker through the
 /// futex cost about 0.2 ms in the KVM guest this was measured on, more than half the parallel work of a small
 /// scene's step), then sleeps on a futex for at most 20 ms at a time (see publish); the caller, the barrier and
-/// waitAtLeast spin `teamSpinCount()` loads, yield 4 times, then sleep for at most 1 ms at a time. A fork-join to a spinning worker costs about 1 us
-/// (bench_rigid_stages BM_team_fork_join).
+/// waitAtLeast spin `teamSpinCount()` loads, yield 4 times, then sleep for at most 1 ms at a time. A fork-join to
+/// a spinning worker costs about 1 us (bench_rigid_stages BM_team_fork_join).
 /// Called from inside a job, or while another thread of the program uses the team, the job runs once on the
 /// calling thread as job(ctx, 0, 1): a job must split its work by (t, n) and give the same result for any n (the
 /// partitioned sweeps do), and must not wait for a partner when n is 1.
@@ -58,8 +58,8 @@ void waitAtLeast(const std::atomic<uint32_t>& a, uint32_t target);
 /// Stores `value` into `a` and wakes every thread sleeping on `a` (waitAtLeast, TeamBarrier, the team). Every
 /// store that a sleeping thread waits for goes through this (or publishAdd), never a bare store and notify.
 ///
-/// DESIGN (a lost wake-up, found in December 2026): bench_rigid_stages BM_team_barrier hung in about one run in
-/// three in a KVM guest: both threads asleep in TeamBarrier::wait, one of them waiting for the phase before the
+/// DESIGN (a lost wake-up, found in December 2026): bench_rigid_stages BM_team_barrier hung in 3 of 13 runs in a
+/// KVM guest: both threads asleep in TeamBarrier::wait, one of them waiting for the phase before the
 /// current one, so its wake-up had been lost. Two fixes were measured and did not cure it: a sequentially
 /// consistent fence between the store and std::atomic::notify_all (libstdc++ 12 skips the wake when its count of
 /// sleepers reads zero, and the plain store and load around that check may be reordered on x86), and the futex
