@@ -146,4 +146,98 @@ TEST_CASE("compact manifold sweeps give the ConstraintRow sweeps' impulses and v
   CHECK(bodiesC[2].w == Vec3::Zero());
 }
 
+TEST_CASE("partitioned sweeps on their own body layout give the serial sweeps' bits in the same order") {
+  // PgsSolver::iterate with a partition sweeps a local copy of the bodies laid out region by region, with the
+  // compact records in region order and the other units' rows re-indexed (pgs.cpp, "Partitioned sweeps"). Its
+  // schedule -- forward: region 0, region 1, boundary; backward: the reverse -- is the serial symmetric sweep
+  // over the units in that order. Rows built in that order therefore give the serial sweeps' result bit for
+  // bit, whatever the layout did: that is the check. Scene: boxes 0, 1 (x < 0, region 0) and 2, 3 (x > 0,
+  // region 1) on a static ground (body 4, shared by both regions: each gets a private copy), box 6 on box 0 and
+  // box 5 on box 3, box 5 tipping (w_x = 3 rad/s: its block update leaves a bound, so compactBlock's fallback
+  // runs on ConstraintRows inside region 1's sweep), a free row on box 1 and one on box 2 (units that are not
+  // manifolds: their rows are swept from the local layout), and a manifold between boxes 1 and 2 (the boundary).
+  std::vector<SolverBodyState> bodies(7);
+  const Vec3 c[7] = {Vec3(-1.5, 0, 0.5), Vec3(-0.5, 0, 0.5), Vec3(0.5, 0, 0.5), Vec3(1.5, 0, 0.5),
+                     Vec3::Zero(),       Vec3(1.5, 0, 1.5),  Vec3(-1.5, 0, 1.5)};
+  for (int i : {0, 1, 2, 3, 5, 6}) {
+    bodies[size_t(i)].invMass = 0.5;
+    bodies[size_t(i)].invInertia = Mat3::Identity() * 3.0;
+    bodies[size_t(i)].v = Vec3(0.01 * i, -0.02, -0.3);
+  }
+  bodies[5].w = Vec3(3.0, 0.2, 0);
+  std::vector<ConstraintRow> rows;
+  PgsPartition p;
+  auto unit = [&](int begin) { p.units.push_back({uint32_t(begin), uint32_t(rows.size()) - uint32_t(begin)}); };
+  auto freeRow = [&](int body) {
+    ConstraintRow r;
+    r.bodyA = body;
+    r.jLinA = Vec3(0.3, 1, 0).normalized();
+    r.jAngA = Vec3(0, 0, 1);
+    r.rhs = 0.05;
+    r.e = 1e-4;
+    r.lo = -1;
+    r.hi = 1;
+    const int begin = int(rows.size());
+    rows.push_back(r);
+    unit(begin);
+  };
+  // Region 0's units, region 1's, then the boundary's: the partition's order is the row order.
+  unit(addManifold(rows, 0, 4, c[0], c[4], Vec3(-1.5, 0, 0), 0.5, 0.6));
+  unit(addManifold(rows, 1, 4, c[1], c[4], Vec3(-0.5, 0, 0), 0.5, 0.6));
+  unit(addManifold(rows, 6, 0, c[6], c[0], Vec3(-1.5, 0, 1), 0.45, 0.5));
+  freeRow(1);
+  unit(addManifold(rows, 2, 4, c[2], c[4], Vec3(0.5, 0, 0), 0.5, 0.6));
+  unit(addManifold(rows, 3, 4, c[3], c[4], Vec3(1.5, 0, 0), 0.5, 0.6));
+  unit(addManifold(rows, 5, 3, c[5], c[3], Vec3(1.55, 0, 1), 0.45, 0.4));
+  freeRow(2);
+  unit(addManifold(rows, 2, 1, c[2], c[1], Vec3(0, 0, 0.5), 0.3, 0.5));
+  for (size_t i = 0; i < rows.size(); ++i)
+    if (rows[i].blockCount > 0) rows[i].lambda = 1.5;  // warm start on every normal row
+  p.bodyPosition.assign(c, c + 7);
+
+  std::vector<ConstraintRow> rowsP = rows, rowsS = rows;
+  std::vector<SolverBodyState> bodiesP = bodies, bodiesS = bodies;
+  PgsBlocks blocksP, blocksS;
+  PgsSolver::prepare(rowsP, bodiesP, &blocksP);
+  PgsSolver::partition(rowsP, bodiesP, p);
+  // The cut is the one intended: x, between boxes 1 and 2; the units keep the row order.
+  constexpr int R = PgsPartition::kRegions;
+  REQUIRE(p.axis == 0);
+  REQUIRE(p.split[1] == 4);
+  REQUIRE(p.split[2] == 8);
+  REQUIRE(p.split[3] == 9);
+  for (size_t u = 0; u < p.order.size(); ++u) REQUIRE(p.order[u].begin == p.units[u].begin);
+  const Real dP = PgsSolver::iterate(rowsP, bodiesP, 10, &blocksP, p);
+  PgsSolver::prepare(rowsS, bodiesS, &blocksS);
+  const Real dS = PgsSolver::iterate(rowsS, bodiesS, 10, &blocksS);
+
+  CHECK(dP == dS);
+  bool clamped = false;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    CHECK_MESSAGE(rowsP[i].lambda == rowsS[i].lambda,
+                  "row " << i << ": partitioned " << rowsP[i].lambda << ", serial " << rowsS[i].lambda);
+    // The rows point at the shared bodies again.
+    CHECK(rowsP[i].bodyA == rows[i].bodyA);
+    CHECK(rowsP[i].bodyB == rows[i].bodyB);
+    clamped |= rows[i].bodyA == 5 && rows[i].blockCount > 0 && rowsS[i].lambda == 0;
+  }
+  CHECK_MESSAGE(clamped, "the tipping box should leave a corner of its manifold at the bound");
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    CAPTURE(b);
+    CHECK(bodiesP[b].v == bodiesS[b].v);
+    CHECK(bodiesP[b].w == bodiesS[b].w);
+  }
+  CHECK(bodiesP[4].v == Vec3::Zero());  // the static ground: its copies' (zero) changes are not written back
+  // Every manifold has a record, found by its first row (the shock pass's lookup), with the shared bodies.
+  int records = 0;
+  for (const PgsBlocks::Manifold& m : blocksP.manifolds) {
+    if (m.n < 0) continue;  // a gap between regions
+    ++records;
+    CHECK(m.a == rows[m.row].bodyA);
+    CHECK(m.b == rows[m.row].bodyB);
+  }
+  CHECK(records == 7);
+  CHECK(R == 2);
+}
+
 }  // TEST_SUITE

@@ -666,60 +666,72 @@ void updateSums(PgsBlocks::Manifold& m, const PgsBlocks::Point* P) {
   m.sumN = pos;
 }
 
+/// Appends the compact record of the manifold contact whose rows start at row i (n normal rows; isCompactManifold
+/// and fitsCompactLayout hold).
+void appendCompact(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                   PgsBlocks& pb, size_t i, int n) {
+  PgsBlocks::Manifold& m = pb.manifolds.emplace_back();
+  const ConstraintRow& t1 = rows[i];
+  m.a = t1.bodyA;
+  m.b = t1.bodyB;
+  m.imA = m.a >= 0 ? bodies[size_t(m.a)].invMass : 0.0;
+  m.imB = m.b >= 0 ? bodies[size_t(m.b)].invMass : 0.0;
+  m.row = uint32_t(i);
+  m.block = uint32_t(rows[i + 3].blockSlot);
+  m.point = uint32_t(pb.points.size());
+  m.n = n;
+  m.cone = t1.pairedRow == int32_t(i) + 1;
+  m.mu = t1.mu;
+  m.muTwist = rows[i + 2].mu;
+  for (int k = 0; k < 3; ++k) {
+    const ConstraintRow& r = rows[i + size_t(k)];
+    m.ang[3 + k] << r.jAngA, r.jAngB;
+    m.w[3 + k] << r.mJAngA, r.mJAngB;
+    m.rhs[k] = r.rhs;
+    m.e[k] = r.e;
+    m.invDiag[k] = r.invDiag;
+    m.lambda[k] = r.lambda;
+  }
+  m.lin[1] = rows[i].jLinA;
+  m.lin[2] = rows[i + 1].jLinA;
+  const PgsBlocks::Block& B = pb.blocks[m.block];
+  m.lin[0] = B.gLinA[0];
+  for (int a = 0; a < 3; ++a) {
+    m.ang[a] << B.gAngA[a], B.gAngB[a];
+    m.w[a] << B.wAngA[a], B.wAngB[a];
+    m.dRhs[a] = B.dRhs[a];
+  }
+  for (int k = 0; k < 6; ++k) m.sInv[k] = B.sInv[0][k];
+  m.ok = B.ok[0];
+  m.axisU = B.axisU;
+  m.axisV = B.axisV;
+  for (int k = 0; k < n; ++k) {
+    const ConstraintRow& r = rows[i + 3 + size_t(k)];
+    pb.points.push_back({r.blockU, r.blockV, r.e, r.lambda, r.lo});
+  }
+  updateSums(m, pb.points.data() + m.point);
+}
+
+/// True when the rows starting at i form a manifold contact of the compact form; n its normal rows.
+bool compactUnit(const std::vector<ConstraintRow>& rows, const PgsBlocks& pb, size_t i, int& n) {
+  return isCompactManifold(rows, i, n) && fitsCompactLayout(rows, i, n, pb.blocks[size_t(rows[i + 3].blockSlot)]);
+}
+
 void buildCompact(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
                   PgsBlocks& pb) {
   pb.manifolds.clear();
   pb.points.clear();
   pb.plan.clear();
+  pb.rowManifold.clear();  // records in row order: compactAt searches them
   size_t runBegin = 0;
   for (size_t i = 0; i < rows.size();) {
     int n = 0;
-    if (!isCompactManifold(rows, i, n) ||
-        !fitsCompactLayout(rows, i, n, pb.blocks[size_t(rows[i + 3].blockSlot)])) {
+    if (!compactUnit(rows, pb, i, n)) {
       i += unitSpan(rows, i);
       continue;
     }
     if (runBegin < i) pb.plan.push_back({uint32_t(runBegin), uint32_t(i), -1});
-    PgsBlocks::Manifold& m = pb.manifolds.emplace_back();
-    const ConstraintRow& t1 = rows[i];
-    m.a = t1.bodyA;
-    m.b = t1.bodyB;
-    m.imA = m.a >= 0 ? bodies[size_t(m.a)].invMass : 0.0;
-    m.imB = m.b >= 0 ? bodies[size_t(m.b)].invMass : 0.0;
-    m.row = uint32_t(i);
-    m.block = uint32_t(rows[i + 3].blockSlot);
-    m.point = uint32_t(pb.points.size());
-    m.n = n;
-    m.cone = t1.pairedRow == int32_t(i) + 1;
-    m.mu = t1.mu;
-    m.muTwist = rows[i + 2].mu;
-    for (int k = 0; k < 3; ++k) {
-      const ConstraintRow& r = rows[i + size_t(k)];
-      m.ang[3 + k] << r.jAngA, r.jAngB;
-      m.w[3 + k] << r.mJAngA, r.mJAngB;
-      m.rhs[k] = r.rhs;
-      m.e[k] = r.e;
-      m.invDiag[k] = r.invDiag;
-      m.lambda[k] = r.lambda;
-    }
-    m.lin[1] = rows[i].jLinA;
-    m.lin[2] = rows[i + 1].jLinA;
-    const PgsBlocks::Block& B = pb.blocks[m.block];
-    m.lin[0] = B.gLinA[0];
-    for (int a = 0; a < 3; ++a) {
-      m.ang[a] << B.gAngA[a], B.gAngB[a];
-      m.w[a] << B.wAngA[a], B.wAngB[a];
-      m.dRhs[a] = B.dRhs[a];
-    }
-    for (int k = 0; k < 6; ++k) m.sInv[k] = B.sInv[0][k];
-    m.ok = B.ok[0];
-    m.axisU = B.axisU;
-    m.axisV = B.axisV;
-    for (int k = 0; k < n; ++k) {
-      const ConstraintRow& r = rows[i + 3 + size_t(k)];
-      pb.points.push_back({r.blockU, r.blockV, r.e, r.lambda, r.lo});
-    }
-    updateSums(m, pb.points.data() + m.point);
+    appendCompact(rows, bodies, pb, i, n);
     pb.plan.push_back({uint32_t(i), uint32_t(i) + 3 + uint32_t(n), int32_t(pb.manifolds.size() - 1)});
     i += 3 + size_t(n);
     runBegin = i;
@@ -729,6 +741,7 @@ void buildCompact(const std::vector<ConstraintRow>& rows, const std::vector<Solv
 
 void writeBackCompact(std::vector<ConstraintRow>& rows, const PgsBlocks& pb) {
   for (const PgsBlocks::Manifold& m : pb.manifolds) {
+    if (m.n < 0) continue;  // a gap between regions (PgsSolver::iterate with a partition)
     for (int k = 0; k < 3; ++k) rows[m.row + uint32_t(k)].lambda = m.lambda[k];
     for (int k = 0; k < m.n; ++k) rows[m.row + 3 + uint32_t(k)].lambda = pb.points[m.point + uint32_t(k)].lambda;
   }
@@ -882,7 +895,15 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
   // stored velocities.
   V.store(m, bodies);
   const size_t first = m.row + 3;
-  for (int i = 0; i < n; ++i) rows[first + size_t(i)].lambda = P[i].lambda;
+  // The rows keep the shared body indices while the partitioned sweeps run on their own copy of the bodies
+  // (PgsSolver::iterate with a partition): for this call they index the bodies the record does.
+  const int32_t rowA = rows[first].bodyA, rowB = rows[first].bodyB;
+  for (int i = 0; i < n; ++i) {
+    ConstraintRow& r = rows[first + size_t(i)];
+    r.lambda = P[i].lambda;
+    r.bodyA = m.a;
+    r.bodyB = m.b;
+  }
   Real maxDelta = 0, d = 0;
   if (solveNormalBlock(rows, bodies, first, -1, d, &pb)) {
     maxDelta = d;
@@ -891,7 +912,12 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
   } else {
     for (size_t k = first + size_t(n); k-- > first;) maxDelta = std::max(maxDelta, solveUnit(rows, bodies, k));
   }
-  for (int i = 0; i < n; ++i) P[i].lambda = rows[first + size_t(i)].lambda;
+  for (int i = 0; i < n; ++i) {
+    ConstraintRow& r = rows[first + size_t(i)];
+    P[i].lambda = r.lambda;
+    r.bodyA = rowA;
+    r.bodyB = rowB;
+  }
   updateSums(m, P);
   V = VisitBodies(m, bodies);
   return maxDelta;
@@ -1200,8 +1226,11 @@ bool solveSupportCompact(std::vector<ConstraintRow>& rows, std::vector<SolverBod
   return true;
 }
 
-/// The compact manifold whose rows start at `row`, or null (records sorted by row).
+/// The compact manifold whose rows start at `row`, or null (records sorted by row, or PgsBlocks::rowManifold).
 const PgsBlocks::Manifold* compactAt(const PgsBlocks& pb, uint32_t row) {
+  if (!pb.rowManifold.empty())
+    return row < pb.rowManifold.size() && pb.rowManifold[row] >= 0 ? &pb.manifolds[size_t(pb.rowManifold[row])]
+                                                                   : nullptr;
   auto it = std::lower_bound(pb.manifolds.begin(), pb.manifolds.end(), row,
                              [](const PgsBlocks::Manifold& m, uint32_t r) { return m.row < r; });
   return it != pb.manifolds.end() && it->row == row ? &*it : nullptr;
@@ -1420,14 +1449,28 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
 // one after the other with the same bits. The boundary runs on thread 0 between barriers. Since the sweeps
 // alternate direction, a forward sweep's boundary is followed by the next backward sweep's boundary and a
 // backward sweep's regions by the next forward sweep's regions, each on the same thread, so every sweep needs
-// one barrier (none when the boundary is empty). Static and kinematic bodies: region 1's units read private
-// copies (as in the coloured sweeps above), so that no two threads store to one body even when adding zero.
-// Manifold contacts are visited from the compact records (PgsBlocks::Manifold), as in the serial sweeps: before
-// this, the partitioned sweeps visited ConstraintRows, which made their solve stage about 40 % slower than the
-// serial one on one thread (pyramid20, 0.86 against 0.62 ms). The records are built after the static bodies are
-// remapped (a region-1 record reads region 1's copies) and pointed back to the shared bodies at the end (the
-// shock pass reads them). The threads are the persistent team (scree/core/parallel.h runTeam), not an OpenMP
-// region: see there why.
+// one barrier (none when the boundary is empty). Manifold contacts are visited from the compact records
+// (PgsBlocks::Manifold), as in the serial sweeps: before this, the partitioned sweeps visited ConstraintRows,
+// which made their solve stage about 40 % slower than the serial one on one thread (pyramid20, 0.86 against
+// 0.62 ms). The threads are the persistent team (scree/core/parallel.h runTeam), not an OpenMP region: see there.
+//
+// DESIGN (memory layout; docs/solver-internals.md "Partitioned sweeps: each thread's own cache lines"): the sweeps
+// run on their own copy of the bodies (PgsPartition::local): region 0's movable bodies, the static and kinematic
+// bodies its units (and the boundary's) touch, a gap of 1 KB, then region 1's likewise. The compact records and
+// their points are laid out region 0, region 1, boundary, with a gap record after each group; a record's
+// bodies are local indices, and the rows of the other units are re-indexed for the sweeps (compactBlock's
+// fallback maps its manifold's rows for its call). At the end the movable bodies are copied back and every index
+// points at the shared bodies again. Why: in the shared arrays the two regions' bodies and records alternate
+// (bodies are numbered as the scene made them, records in contact order), and a line of one region sits next
+// to a line of the other. Although no line was written by both threads, pyramid20's region sweeps ran at less
+// than half speed on two threads: 0.33 ms per thread per step for half the units, against 0.27 ms for all of
+// them on one thread (perf: the time in the loads of bodies and of the records' body indices). Spacing the
+// bodies 256 bytes apart and the records 128 bytes apart cured it (0.15 ms per thread), and 64-byte alignment
+// alone did not, so the lines a thread reads were taken from the other thread's cache by their neighbours
+// (the L2 fetches lines in pairs). The local layout gives the same separation without padding every body:
+// region sweeps 0.17 ms per thread. Static bodies get a private copy per region, so that no two threads store
+// to one body even when adding zero. The result is the serial sweeps' over the units in partition order, bit
+// for bit (test_unit_compact_sweeps).
 namespace {
 /// One unit: its compact manifold record, or its ConstraintRows.
 inline Real visitUnit(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
@@ -1467,38 +1510,79 @@ int partitionThreads(bool worthIt) { return worthIt ? std::min(PgsPartition::kRe
 Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
                         PgsBlocks* blocks, PgsPartition& p) {
   constexpr int R = PgsPartition::kRegions;
-  // Private copies of static and kinematic bodies for the units of regions 1 .. R-1 (one per body and region).
-  const size_t numBodies = bodies.size();
-  p.remapped.clear();
-  for (int g = 1; g < R; ++g) {
-    p.tmp.assign(numBodies, 0);  // 1 + index of the copy
-    for (uint32_t u = p.split[g]; u < p.split[g + 1]; ++u)
+  const size_t nb = bodies.size();
+  const uint32_t* split = p.split;
+  // Group g's units: region g's, and for region 0 the boundary's too (thread 0 sweeps both).
+  auto forUnitsOf = [&](int g, auto&& f) {
+    for (uint32_t u = split[g]; u < split[g + 1]; ++u) f(u);
+    if (g == 0)
+      for (uint32_t u = split[R]; u < split[R + 1]; ++u) f(u);
+  };
+  auto movableBody = [&](int32_t b) { return size_t(b) < p.bodyRegion.size() && p.bodyRegion[size_t(b)] >= 0; };
+  // The bodies' local layout (PgsPartition::local): per region its movable bodies, the static and kinematic
+  // bodies its units touch (private copies), then a gap.
+  constexpr int kGapBodies = 8;  // 1 KB: more than the two-line pairs the L2 prefetcher fetches together
+  p.globalOf.clear();
+  p.localOf.assign(size_t(R) * nb, -1);
+  for (int g = 0; g < R; ++g) {
+    for (size_t b = 0; b < nb; ++b)
+      if (movableBody(int32_t(b)) && p.bodyRegion[b] == g) {
+        for (int h = 0; h < R; ++h) p.localOf[size_t(h) * nb + b] = int32_t(p.globalOf.size());
+        p.globalOf.push_back(int32_t(b));
+      }
+    forUnitsOf(g, [&](uint32_t u) {
       for (uint32_t i = p.order[u].begin; i < p.order[u].begin + p.order[u].count; ++i)
-        for (int side = 0; side < 2; ++side) {
-          int32_t& b = side == 0 ? rows[i].bodyA : rows[i].bodyB;
-          if (b < 0 || size_t(b) >= numBodies || movable(bodies[size_t(b)])) continue;
-          if (p.tmp[size_t(b)] == 0) {
-            p.tmp[size_t(b)] = uint32_t(bodies.size()) + 1;
-            const SolverBodyState body = bodies[size_t(b)];
-            bodies.push_back(body);
+        for (const int32_t b : {rows[i].bodyA, rows[i].bodyB})
+          if (b >= 0 && size_t(b) < nb && !movableBody(b) && p.localOf[size_t(g) * nb + size_t(b)] < 0) {
+            p.localOf[size_t(g) * nb + size_t(b)] = int32_t(p.globalOf.size());
+            p.globalOf.push_back(b);
           }
-          p.remapped.push_back({i, side, b});
-          b = int32_t(p.tmp[size_t(b)] - 1);
-        }
+    });
+    p.globalOf.insert(p.globalOf.end(), kGapBodies, -1);
   }
-  // Each unit's compact record (-1: its ConstraintRows).
+  p.local.resize(p.globalOf.size());
+  for (size_t k = 0; k < p.globalOf.size(); ++k)
+    p.local[k] = p.globalOf[k] >= 0 ? bodies[size_t(p.globalOf[k])] : SolverBodyState{};
+  // Each unit's compact record (-1: its ConstraintRows), laid out region by region with a gap after each group,
+  // so that no cache line (nor the line the prefetcher pairs with it) holds records of two threads.
   const size_t nu = p.order.size();
   p.unitManifold.assign(nu, -1);
   if (blocks) {
-    buildCompact(rows, bodies, *blocks);
-    for (size_t u = 0; u < nu; ++u)
-      if (const PgsBlocks::Manifold* m = compactAt(*blocks, p.order[u].begin))
-        if (m->row + 3 + uint32_t(m->n) == p.order[u].begin + p.order[u].count)
-          p.unitManifold[u] = int32_t(m - blocks->manifolds.data());
+    PgsBlocks& pb = *blocks;
+    pb.manifolds.clear();
+    pb.points.clear();
+    pb.plan.clear();
+    pb.rowManifold.assign(rows.size(), -1);
+    for (int g = 0; g <= R; ++g) {
+      for (uint32_t u = split[g]; u < split[g + 1]; ++u) {
+        int n = 0;
+        const uint32_t i = p.order[u].begin;
+        if (!compactUnit(rows, pb, i, n) || 3 + uint32_t(n) != p.order[u].count) continue;
+        p.unitManifold[u] = int32_t(pb.manifolds.size());
+        pb.rowManifold[i] = int32_t(pb.manifolds.size());
+        appendCompact(rows, bodies, pb, i, n);
+        PgsBlocks::Manifold& m = pb.manifolds.back();
+        const size_t view = size_t(g < R ? g : 0) * nb;
+        if (m.a >= 0 && size_t(m.a) < nb) m.a = p.localOf[view + size_t(m.a)];
+        if (m.b >= 0 && size_t(m.b) < nb) m.b = p.localOf[view + size_t(m.b)];
+      }
+      pb.manifolds.emplace_back().n = -1;  // a gap (about 1 KB), never visited
+      pb.points.resize(pb.points.size() + 32, PgsBlocks::Point{0, 0, 0, 0, 0});
+    }
   }
+  // The rows of the other units (joints, single contacts) index the local layout until the end of the sweeps
+  // (a compact record's rows keep the shared indices: compactBlock's fallback maps them for its call).
+  for (int g = 0; g < R; ++g)
+    forUnitsOf(g, [&](uint32_t u) {
+      if (p.unitManifold[u] >= 0) return;
+      for (uint32_t i = p.order[u].begin; i < p.order[u].begin + p.order[u].count; ++i)
+        for (int32_t* b : {&rows[i].bodyA, &rows[i].bodyB})
+          if (*b >= 0 && size_t(*b) < nb) *b = p.localOf[size_t(g) * nb + size_t(*b)];
+    });
+  std::vector<SolverBodyState>& shared = bodies;
+  std::vector<SolverBodyState>& lb = p.local;
   const PgsPartition::Unit* order = p.order.data();
   const int32_t* manifold = p.unitManifold.data();
-  const uint32_t* split = p.split;
   const bool boundary = split[R + 1] > split[R];
   const int threads = partitionThreads(nu >= 64);
   Real lastSweep[R] = {};
@@ -1508,11 +1592,11 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     auto regions = [&](bool forward) {
       for (int g = 0; g < R; ++g)
         if (g % nt == t)
-          local = std::max(local, sweepUnits(rows, bodies, order, manifold, split[g], split[g + 1], forward, blocks));
+          local = std::max(local, sweepUnits(rows, lb, order, manifold, split[g], split[g + 1], forward, blocks));
     };
     auto boundaryUnits = [&](bool forward) {
       if (t == 0)
-        local = std::max(local, sweepUnits(rows, bodies, order, manifold, split[R], split[R + 1], forward, blocks));
+        local = std::max(local, sweepUnits(rows, lb, order, manifold, split[R], split[R + 1], forward, blocks));
     };
     for (int it = 0; it < iterations; ++it) {
       const bool forward = it % 2 == 0;
@@ -1528,14 +1612,25 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   Real maxDelta = 0;
   for (int t = 0; t < R; ++t) maxDelta = std::max(maxDelta, lastSweep[t]);
   if (blocks) writeBackCompact(rows, *blocks);
-  // Back to the shared static bodies (rows and records).
-  for (const PgsPartition::Remap& r : p.remapped) (r.side == 0 ? rows[r.row].bodyA : rows[r.row].bodyB) = r.body;
-  if (blocks && !p.remapped.empty())
-    for (PgsBlocks::Manifold& m : blocks->manifolds) {
-      m.a = rows[m.row].bodyA;
-      m.b = rows[m.row].bodyB;
-    }
-  bodies.resize(numBodies);
+  // Back to the shared bodies: the movable bodies' velocities (the static copies changed nothing), the rows' and
+  // the records' body indices (the shock pass reads them).
+  for (size_t k = 0; k < p.globalOf.size(); ++k)
+    if (p.globalOf[k] >= 0 && movableBody(p.globalOf[k])) shared[size_t(p.globalOf[k])] = lb[k];
+  auto shared_ = [&](int32_t& b) {
+    if (b >= 0 && size_t(b) < p.globalOf.size()) b = p.globalOf[size_t(b)];
+  };
+  for (size_t u = 0; u < nu; ++u)
+    if (p.unitManifold[u] < 0)
+      for (uint32_t i = p.order[u].begin; i < p.order[u].begin + p.order[u].count; ++i) {
+        shared_(rows[i].bodyA);
+        shared_(rows[i].bodyB);
+      }
+  if (blocks)
+    for (PgsBlocks::Manifold& m : blocks->manifolds)
+      if (m.n >= 0) {
+        shared_(m.a);
+        shared_(m.b);
+      }
   return maxDelta;
 }
 

@@ -102,6 +102,10 @@ struct PgsBlocks {
   std::vector<Manifold> manifolds;
   std::vector<Point> points;
   std::vector<Unit> plan;
+  /// Per ConstraintRow: the record whose rows start there, or -1; filled only when the records are not in row
+  /// order (the partitioned sweeps lay them out region by region), empty otherwise (the records are then
+  /// searched by row). Records with n < 0 are gaps between regions, never visited.
+  std::vector<int32_t> rowManifold;
 };
 
 // ---- issue 18 (sweep scheduling): graph-coloured sweeps (pgs.cpp, docs/solver-internals.md "Coloured sweeps") ----
@@ -164,13 +168,13 @@ struct PgsPartition {
   std::vector<Real> bodyWeight;
   std::vector<int8_t> unitGroup;
   std::vector<uint64_t> signature;  ///< the units' body pairs and row counts when the cut was last made
-  struct Remap {
-    uint32_t row;
-    int side;
-    int32_t body;
-  };
-  std::vector<Remap> remapped;
   std::vector<int32_t> unitManifold;  ///< per unit of `order`: its compact record (PgsBlocks::manifolds) or -1
+  /// The sweeps' own copy of the bodies, region by region (PgsSolver::iterate with a partition): each region's
+  /// movable bodies, then the static and kinematic bodies its units touch (private copies; region 0's serve the
+  /// boundary too), then a gap. `localOf[g * n + b]` is body b's slot as region g's units see it (n bodies;
+  /// movable bodies have one slot in every view), `globalOf` each slot's body (-1 in the gaps).
+  std::vector<SolverBodyState> local;
+  std::vector<int32_t> localOf, globalOf;
   /// Shock pass (PgsSolver::shockPass with a partition): per range, the thread list it belongs to and how many
   /// ranges of the other list must be finished before it runs.
   std::vector<uint32_t> shockList[kRegions];
