@@ -1531,12 +1531,12 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
         p.globalOf.push_back(int32_t(b));
       }
     forUnitsOf(g, [&](uint32_t u) {
-      for (uint32_t i = p.order[u].begin; i < p.order[u].begin + p.order[u].count; ++i)
-        for (const int32_t b : {rows[i].bodyA, rows[i].bodyB})
-          if (b >= 0 && size_t(b) < nb && !movableBody(b) && p.localOf[size_t(g) * nb + size_t(b)] < 0) {
-            p.localOf[size_t(g) * nb + size_t(b)] = int32_t(p.globalOf.size());
-            p.globalOf.push_back(b);
-          }
+      const ConstraintRow& r = rows[p.order[u].begin];  // every row of a unit acts on the same two bodies
+      for (const int32_t b : {r.bodyA, r.bodyB})
+        if (b >= 0 && size_t(b) < nb && !movableBody(b) && p.localOf[size_t(g) * nb + size_t(b)] < 0) {
+          p.localOf[size_t(g) * nb + size_t(b)] = int32_t(p.globalOf.size());
+          p.globalOf.push_back(b);
+        }
     });
     p.globalOf.insert(p.globalOf.end(), kGapBodies, -1);
   }
