@@ -1468,7 +1468,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
 // bodies 256 bytes apart and the records 128 bytes apart cured it (0.15 ms per thread), and 64-byte alignment
 // alone did not, so the lines a thread reads were taken from the other thread's cache by their neighbours
 // (the L2 fetches lines in pairs). The local layout gives the same separation without padding every body:
-// region sweeps 0.17 ms per thread. Static bodies get a private copy per region, so that no two threads store
+// region sweeps 0.15-0.18 ms per thread. Static bodies get a private copy per region, so that no two threads store
 // to one body even when adding zero. The result is the serial sweeps' over the units in partition order, bit
 // for bit (test_unit_compact_sweeps).
 namespace {
@@ -1521,7 +1521,8 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   auto movableBody = [&](int32_t b) { return size_t(b) < p.bodyRegion.size() && p.bodyRegion[size_t(b)] >= 0; };
   // The bodies' local layout (PgsPartition::local): per region its movable bodies, the static and kinematic
   // bodies its units touch (private copies), then a gap.
-  constexpr int kGapBodies = 8;  // 1 KB: more than the two-line pairs the L2 prefetcher fetches together
+  constexpr int kGapBodies = 8;    // 1 KB: more than the two-line pairs the L2 prefetcher fetches together
+  constexpr int kGapPoints = 32;   // about 1 KB of PgsBlocks::Point likewise
   p.globalOf.clear();
   p.localOf.assign(size_t(R) * nb, -1);
   for (int g = 0; g < R; ++g) {
@@ -1567,7 +1568,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
         if (m.b >= 0 && size_t(m.b) < nb) m.b = p.localOf[view + size_t(m.b)];
       }
       pb.manifolds.emplace_back().n = -1;  // a gap (about 1 KB), never visited
-      pb.points.resize(pb.points.size() + 32, PgsBlocks::Point{0, 0, 0, 0, 0});
+      pb.points.resize(pb.points.size() + kGapPoints, PgsBlocks::Point{0, 0, 0, 0, 0});
     }
   }
   // The rows of the other units (joints, single contacts) index the local layout until the end of the sweeps
@@ -1579,7 +1580,6 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
         for (int32_t* b : {&rows[i].bodyA, &rows[i].bodyB})
           if (*b >= 0 && size_t(*b) < nb) *b = p.localOf[size_t(g) * nb + size_t(*b)];
     });
-  std::vector<SolverBodyState>& shared = bodies;
   std::vector<SolverBodyState>& lb = p.local;
   const PgsPartition::Unit* order = p.order.data();
   const int32_t* manifold = p.unitManifold.data();
@@ -1615,21 +1615,21 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   // Back to the shared bodies: the movable bodies' velocities (the static copies changed nothing), the rows' and
   // the records' body indices (the shock pass reads them).
   for (size_t k = 0; k < p.globalOf.size(); ++k)
-    if (p.globalOf[k] >= 0 && movableBody(p.globalOf[k])) shared[size_t(p.globalOf[k])] = lb[k];
-  auto shared_ = [&](int32_t& b) {
+    if (p.globalOf[k] >= 0 && movableBody(p.globalOf[k])) bodies[size_t(p.globalOf[k])] = lb[k];
+  auto toShared = [&](int32_t& b) {
     if (b >= 0 && size_t(b) < p.globalOf.size()) b = p.globalOf[size_t(b)];
   };
   for (size_t u = 0; u < nu; ++u)
     if (p.unitManifold[u] < 0)
       for (uint32_t i = p.order[u].begin; i < p.order[u].begin + p.order[u].count; ++i) {
-        shared_(rows[i].bodyA);
-        shared_(rows[i].bodyB);
+        toShared(rows[i].bodyA);
+        toShared(rows[i].bodyB);
       }
   if (blocks)
     for (PgsBlocks::Manifold& m : blocks->manifolds)
       if (m.n >= 0) {
-        shared_(m.a);
-        shared_(m.b);
+        toShared(m.a);
+        toShared(m.b);
       }
   return maxDelta;
 }

@@ -164,7 +164,7 @@ struct PgsPartition {
   std::vector<int8_t> bodyRegion;  ///< per solver body: its region, -1 for static and kinematic bodies
   int axis = 0;                    ///< the cutting plane's normal (0 x, 1 y, 2 z)
   // Scratch (reused).
-  std::vector<uint32_t> sortedBodies, tmp;
+  std::vector<uint32_t> sortedBodies;
   std::vector<Real> bodyWeight;
   std::vector<int8_t> unitGroup;
   std::vector<uint64_t> signature;  ///< the units' body pairs and row counts when the cut was last made
