@@ -15,6 +15,7 @@
 #include "scree/collide/space.h"
 #include "scree/collide/uniform_grid.h"
 #include "scree/core/rigid_body.h"
+#include "radix_sort.h"  // collide/src
 
 using namespace scree;
 using scree::detail::UniformGrid;
@@ -103,6 +104,40 @@ TEST_CASE("uniform grid reports exactly the brute-force pair set for several siz
         else CHECK(grid.getUsedCellSize() > 0);
         CHECK(grid.getNumCandidateTests() >= pairs.size());  // a pair is reported only after its AABB test
       }
+}
+
+TEST_CASE("the grid's radix sort of 64-bit keys gives std::sort's order for every key pattern") {
+  // radixSortKeys (collide/src/radix_sort.h) skips the bytes all keys share and scatters the others; each
+  // pattern below makes a different set of bytes vary: the grid's two key forms, keys differing only in their
+  // top or bottom byte, duplicates, presorted and reversed runs, every size from the std::sort cut-over up.
+  std::mt19937_64 rng(20261204);
+  std::vector<uint64_t> tmp;
+  int checked = 0;
+  for (size_t n : {size_t(0), size_t(1), size_t(63), size_t(64), size_t(65), size_t(500), size_t(4097)}) {
+    for (int pattern = 0; pattern < 7; ++pattern) {
+      std::vector<uint64_t> keys(n);
+      for (size_t i = 0; i < n; ++i) {
+        const uint64_t r = rng();
+        switch (pattern) {
+          case 0: keys[i] = r; break;                                          // all bytes vary
+          case 1: keys[i] = (r & 0xffffffffu) << 32 | uint64_t(i / 3); break;  // cell keys: hash << 32 | box
+          case 2: keys[i] = (r % 211) << 32 | ((r >> 20) % 211); break;       // pair keys of 211 boxes
+          case 3: keys[i] = (r & 0xff) << 56 | 0x0123456789abcdull; break;    // only the top byte varies
+          case 4: keys[i] = 0xfedcba9876543200ull | (r & 0x3); break;         // only the bottom byte, duplicates
+          case 5: keys[i] = uint64_t(i) * 0x10001ull; break;                  // presorted
+          default: keys[i] = ~uint64_t(i) << 7; break;                        // reversed, low bits zero
+        }
+      }
+      std::vector<uint64_t> expected = keys;
+      std::sort(expected.begin(), expected.end());
+      const size_t tmpSize = tmp.size();
+      scree::detail::radixSortKeys(keys, tmp);
+      CHECK_MESSAGE(keys == expected, "n = " << n << ", pattern " << pattern);
+      CHECK(tmp.size() >= tmpSize);  // the scratch only grows: no per-step allocation once warm
+      ++checked;
+    }
+  }
+  CHECK(checked == 49);
 }
 
 TEST_CASE("uniform grid picks twice the median extent and is repeatable across calls") {

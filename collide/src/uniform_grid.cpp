@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "radix_sort.h"
 #include "scree/core/errors.h"
 
 namespace scree::detail {
@@ -146,7 +147,7 @@ void UniformGrid::findPairs(const std::vector<Aabb>& boxes, std::vector<std::pai
         for (int64_t z = z0; z <= z1; ++z) cellKeys_.push_back((uint64_t(cellHash(x, y, z)) << 32) | i);
   }
   finite_.resize(kept);
-  std::sort(cellKeys_.begin(), cellKeys_.end());
+  radixSortKeys(cellKeys_, sortTmp_);
   cellKeys_.erase(std::unique(cellKeys_.begin(), cellKeys_.end()), cellKeys_.end());
 
   // --- 3. pairs within each bucket, owner-cell rule -----------------------------------------------------
@@ -190,7 +191,7 @@ void UniformGrid::findPairs(const std::vector<Aabb>& boxes, std::vector<std::pai
   }
 
   // --- 5. sorted output ------------------------------------------------------------------------------------
-  std::sort(pairKeys_.begin(), pairKeys_.end());
+  radixSortKeys(pairKeys_, sortTmp_);
   outPairs.reserve(pairKeys_.size());
   for (uint64_t k : pairKeys_) outPairs.emplace_back(uint32_t(k >> 32), uint32_t(k));
 }

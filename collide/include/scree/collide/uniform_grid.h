@@ -53,6 +53,7 @@ class UniformGrid {
   std::vector<uint32_t> finite_;
   std::vector<Real> sizes_;
   std::vector<uint64_t> pairKeys_;
+  std::vector<uint64_t> sortTmp_;  ///< radixSortKeys' scatter buffer
 };
 
 }  // namespace scree::detail
