@@ -48,15 +48,22 @@ inline void integrateRotation(RigidBody& b, Real h) {
     const int k = axes[s];
     const Real theta = frac[s] * h * Lp[k] / I[k];
     // The body turns by theta about its own principal axis k; L (fixed in the world) turns by -theta
-    // in principal coordinates.
-    const Real c = std::cos(theta), sn = std::sin(theta);
+    // in principal coordinates. One sine and cosine of the half angle serve both: the turn's quaternion is
+    // (cos theta/2, sin theta/2 e_k), and cos theta = 1 - 2 sin^2 theta/2, sin theta = 2 sin theta/2 cos theta/2
+    // (issue 18: the two angles' sin and cos and the general quaternion product were 10 % of chain20's step).
+    const Real sh = std::sin(0.5 * theta), ch = std::cos(0.5 * theta);
+    const Real c = 1 - 2 * sh * sh, sn = 2 * sh * ch;
     const int i = (k + 1) % 3, j = (k + 2) % 3;
     const Real li = Lp[i], lj = Lp[j];
     Lp[i] = c * li + sn * lj;
     Lp[j] = -sn * li + c * lj;
-    Vec3 axis = Vec3::Zero();
-    axis[k] = 1;
-    qp = qp * Quat(Eigen::AngleAxis<Real>(theta, axis));
+    // qp (w, v) times (ch, sh e_k): w ch - v_k sh, and ch v + w sh e_k + sh v x e_k, where v x e_k has
+    // v_j at i, -v_i at j and 0 at k.
+    const Real qw = qp.w(), vi = qp.vec()[i], vj = qp.vec()[j], vk = qp.vec()[k];
+    qp.w() = qw * ch - vk * sh;
+    qp.vec()[k] = vk * ch + qw * sh;
+    qp.vec()[i] = vi * ch + vj * sh;
+    qp.vec()[j] = vj * ch - vi * sh;
   }
   // Energy projection: the splitting conserves |L| exactly but the energy only to O(h^2). Move L (principal
   // coordinates) on its sphere |L| = const to the ellipsoid sum L_k^2 / (2 I_k) = T0 with Newton steps along the
