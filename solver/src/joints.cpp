@@ -21,6 +21,12 @@ Vec3 checkedAxis(const char* where, const Vec3& axis) {
   return axis.normalized();
 }
 Real wrapPi(Real a) { return std::remainder(a, 2 * M_PI); }
+// A new row is a copy of one default row: block moves instead of value-initialising each of its ~350 bytes field
+// by field (as contact_rows.cpp does; issue 18, chain20's row stage and position projection).
+ConstraintRow& appendRow(std::vector<ConstraintRow>& rows) {
+  static const ConstraintRow kDefaultRow{};
+  return rows.emplace_back(kDefaultRow);
+}
 // A [lower, upper] interval whose ends may be infinite on their own side.
 void checkInterval(const char* where, Real lower, Real upper) {
   if (std::isnan(lower) || lower == INFINITY) detail::throwInvalid(where, "lower", lower, "must be < +inf");
@@ -122,7 +128,7 @@ void Joint::pushLinear(const ConstraintContext& ctx, std::vector<ConstraintRow>&
                        const FrameState& f, const Vec3& u, Real g, Real compliance, Real damping) const {
   // Issue 18 (fixed cost of small scenes): rows are built in place in the row array (a ConstraintRow is about
   // 340 bytes; building it on the stack and copying it in was a third of chain20's row stage).
-  ConstraintRow& r = rows.emplace_back();
+  ConstraintRow& r = appendRow(rows);
   r.jLinA = u;
   r.jAngA = f.rA.cross(u);
   r.jLinB = -u;
@@ -135,7 +141,7 @@ void Joint::pushLinear(const ConstraintContext& ctx, std::vector<ConstraintRow>&
 
 void Joint::pushAngular(const ConstraintContext& ctx, std::vector<ConstraintRow>& rows, std::vector<int>& dofs, int dof,
                         const Vec3& a, Real g, Real compliance, Real damping) const {
-  ConstraintRow& r = rows.emplace_back();
+  ConstraintRow& r = appendRow(rows);
   r.jAngA = a;
   r.jAngB = -a;
   finishRow(ctx, r, dof, g, compliance, damping);
@@ -150,7 +156,7 @@ void Joint::pushBending(const ConstraintContext& ctx, std::vector<ConstraintRow>
   for (int k = 0; k < 2; ++k) {
     const Vec3 p = f.RB.col(k);
     const Vec3 c = nA.cross(p);
-    ConstraintRow& r = rows.emplace_back();
+    ConstraintRow& r = appendRow(rows);
     r.jAngA = c;
     r.jAngB = -c;
     finishRow(ctx, r, firstDof + k, nA.dot(p), compliance_[firstDof + k], damping_[firstDof + k]);

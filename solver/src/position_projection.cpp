@@ -80,7 +80,7 @@ void projectPositions(SimulationState& s) {
       c->addRows(ctx, s.projRows, s.projDofs);
       size_t keep = begin;
       for (size_t k = begin; k < s.projRows.size(); ++k) {
-        ConstraintRow r = s.projRows[k];
+        ConstraintRow& r = s.projRows[k];  // edited in place, moved down only past dropped rows
         if (!r.holonomic || r.lo > -1e299 || r.hi < 1e299 || !std::isfinite(r.drift)) continue;
         const Real kd = massTerm(r);
         if (!(kd > 0) || !(r.e < kRigid * kd)) continue;
@@ -91,7 +91,8 @@ void projectPositions(SimulationState& s) {
         r.normalRow = -1;
         r.pairedRow = -1;
         r.solveType = FrictionModel::DIRECT;
-        s.projRows[keep++] = r;
+        if (keep != k) s.projRows[keep] = r;
+        ++keep;
       }
       s.projRows.resize(keep);
     }
