@@ -50,7 +50,8 @@ inline void integrateRotation(RigidBody& b, Real h) {
     // The body turns by theta about its own principal axis k; L (fixed in the world) turns by -theta
     // in principal coordinates. One sine and cosine of the half angle serve both: the turn's quaternion is
     // (cos theta/2, sin theta/2 e_k), and cos theta = 1 - 2 sin^2 theta/2, sin theta = 2 sin theta/2 cos theta/2
-    // (issue 18: the two angles' sin and cos and the general quaternion product were 10 % of chain20's step).
+    // (issue 18: the two angles' sin and cos and the general quaternion product were 10 % of the step of
+    // `scree run chain20`, perf).
     const Real sh = std::sin(0.5 * theta), ch = std::cos(0.5 * theta);
     const Real c = 1 - 2 * sh * sh, sn = 2 * sh * ch;
     const int i = (k + 1) % 3, j = (k + 2) % 3;
