@@ -460,3 +460,47 @@ TEST_CASE("persistent box-box manifolds stay within their tolerance of a fresh c
   CHECK(cached.space.getNumReusedManifolds() == 0);
   same();
 }
+
+// The lookup of last step's manifold among many (Space::reuseManifold searches the sorted pair keys): a column of
+// boxes resting face on face and a row beside it on a static slab, 13 box-box pairs. A lookup that misses some
+// keys (an off-by-one in the search finds only the first or last) would re-clip those pairs silently: the
+// contacts would still be right, so the count of reused manifolds is what is checked. With nothing moved, every
+// pair is reused on the second collide, and its points are the first clip's bit for bit.
+TEST_CASE("persistent box-box manifolds: every pair of a resting pile is found and reused") {
+  Space space;
+  std::vector<RigidBodyRef> bodies;
+  std::vector<GeometryRef> geoms;
+  auto addBox = [&](const Vec3& half, const Vec3& p, bool dynamic) {
+    GeometryRef g = std::make_shared<Geometry>(std::make_shared<Box>(half));
+    if (dynamic) {
+      RigidBodyRef b = std::make_shared<RigidBody>();
+      b->add(g);
+      b->setPosition(p);
+      bodies.push_back(b);
+    } else {
+      g->setPosition(p);
+    }
+    space.add(g);
+    geoms.push_back(g);
+  };
+  addBox(Vec3(10, 10, 0.5), Vec3(0, 0, -0.5), false);  // the slab
+  const Real h = 0.25, depth = 1e-3;                     // half size and overlap of each resting contact
+  for (int i = 0; i < 7; ++i) addBox(Vec3(h, h, h), Vec3(0, 0, h + i * (2 * h - depth) - depth), true);  // column
+  for (int i = 1; i <= 6; ++i) addBox(Vec3(h, h, h), Vec3(3 * i * h, 2, h - depth), true);              // row
+  std::vector<GeometryContact> first, second;
+  space.collide(1.0 / 60, first);
+  CHECK(space.getNumReusedManifolds() == 0);
+  REQUIRE(first.size() == 13);  // 6 contacts up the column, 7 boxes on the slab
+  space.collide(1.0 / 60, second);
+  CHECK(space.getNumReusedManifolds() == 13);
+  REQUIRE(second.size() == first.size());
+  for (size_t c = 0; c < first.size(); ++c) {
+    REQUIRE(second[c].points().size() == first[c].points().size());
+    CHECK(second[c].points().size() == 4);
+    for (size_t k = 0; k < first[c].points().size(); ++k) {
+      CHECK((second[c].points()[k].point - first[c].points()[k].point).norm() < 1e-12);
+      CHECK(std::abs(second[c].points()[k].depth - first[c].points()[k].depth) < 1e-12);
+      CHECK(second[c].points()[k].featureId == first[c].points()[k].featureId);
+    }
+  }
+}
