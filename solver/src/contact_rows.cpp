@@ -159,11 +159,9 @@ void buildContactRows(SimulationState& s) {
     const int32_t base = int32_t(s.rows.size());
     int32_t nextFriction = base;
     int32_t nextNormal = base + int32_t(nFriction);
-    // The new rows are copies of a default row, filled in place below (setPointJacobian, contact_law.h). Copying
-    // one prototype is block moves; value-initialising each ~300-byte row field by field was 2.4 % of pyramid20's
-    // step (std::vector::_M_default_append, issue 18).
-    static const ConstraintRow kDefaultRow{};
-    s.rows.resize(s.rows.size() + nFriction + nActive, kDefaultRow);
+    // The new rows are copies of the default row (constraint_row.h), filled in place below (setPointJacobian,
+    // contact_law.h).
+    s.rows.resize(s.rows.size() + nFriction + nActive, defaultConstraintRow());
     s.couplings.push_back({ia, ib, uint32_t(base), nFriction + nActive, false});
     // Weight-based normal impulse estimate for box friction on new contacts: the lighter dynamic body's weight.
     const Real massA = dynA ? 1.0 / s.sb[ia].invMass : 0, massB = dynB ? 1.0 / s.sb[ib].invMass : 0;

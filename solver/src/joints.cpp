@@ -21,12 +21,8 @@ Vec3 checkedAxis(const char* where, const Vec3& axis) {
   return axis.normalized();
 }
 Real wrapPi(Real a) { return std::remainder(a, 2 * M_PI); }
-// A new row is a copy of one default row: block moves instead of value-initialising each of its ~350 bytes field
-// by field (as contact_rows.cpp does; issue 18, chain20's row stage and position projection).
-ConstraintRow& appendRow(std::vector<ConstraintRow>& rows) {
-  static const ConstraintRow kDefaultRow{};
-  return rows.emplace_back(kDefaultRow);
-}
+// A new row is a copy of the default row (constraint_row.h), as the contact rows are.
+ConstraintRow& appendRow(std::vector<ConstraintRow>& rows) { return rows.emplace_back(detail::defaultConstraintRow()); }
 // A [lower, upper] interval whose ends may be infinite on their own side.
 void checkInterval(const char* where, Real lower, Real upper) {
   if (std::isnan(lower) || lower == INFINITY) detail::throwInvalid(where, "lower", lower, "must be < +inf");
