@@ -105,6 +105,33 @@ class WarmStartCache {
     const Entry* base = current_.data();
     return {base + (it - current_.begin()), base + (end - current_.begin())};
   }
+  /// pairRange(pair) for pairs asked in ascending order (the row build's contacts are sorted by pair, like the
+  /// entries): a cursor walks the entries forward from the last pair's, so a step's lookups are one pass over the
+  /// cache instead of a binary search each, whose first probes missed the cache (perf: 2.7 % of buildContactRows
+  /// on pyramid20, issue 18). A pair below the cursor (contacts not in pair order) falls back to the binary
+  /// search. Start each pass with resetCursor(). The range is pairRange's.
+  std::pair<const Entry*, const Entry*> pairRangeAscending(uint64_t pair) {
+    const Entry* base = current_.data();
+    const Entry* last = base + current_.size();
+    const Entry* it = base + cursor_;
+    if (it != base && it[-1].pair >= pair) return pairRange(pair);  // behind the cursor
+    // Forward: a few entries linearly (the next pair's are usually next), then a binary search of the rest.
+    constexpr int kLinear = 8;
+    int k = 0;
+    while (it != last && it->pair < pair && k < kLinear) {
+      ++it;
+      ++k;
+    }
+    if (it != last && it->pair < pair) {
+      const Entry key{pair, 0, 0, Vec3::Zero(), 0, Vec3::Zero()};
+      it = base + (std::lower_bound(current_.begin() + (it - base), current_.end(), key) - current_.begin());
+    }
+    const Entry* end = it;
+    while (end != last && end->pair == pair) ++end;
+    cursor_ = size_t(end - base);
+    return {it, end};
+  }
+  void resetCursor() { cursor_ = 0; }
   static const Entry* find(std::pair<const Entry*, const Entry*> range, uint32_t feature, const Vec3& point) {
     for (const Entry* e = range.first; e != range.second; ++e)
       if (e->feature == feature) return e;
@@ -139,10 +166,12 @@ class WarmStartCache {
       next_[j] = e;
     }
     std::swap(current_, next_);
+    cursor_ = 0;
   }
 
  private:
   std::vector<Entry> current_, next_;
+  size_t cursor_ = 0;  ///< pairRangeAscending: the first entry after the last pair asked
 };
 
 }  // namespace scree::detail
