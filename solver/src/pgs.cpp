@@ -599,6 +599,19 @@ static Real sweepRows(std::vector<ConstraintRow>& rows, std::vector<SolverBodySt
 // support from the same record (solveSupportCompact). A manifold whose rows do not have the contact layout
 // (fitsCompactLayout) keeps the ConstraintRow sweeps. PgsSolver::prepare clears the records, so a path that does
 // not rebuild them (the hybrid and coloured sweeps) never reads last step's.
+// The manifold visit's parts (VisitBodies, compactFriction and its lambdas, compactBlock's accepted update) are
+// forced inline into the visit: out of line, the bodies' velocities in VisitBodies went through memory between
+// the parts, and each part's first 16-byte load of (w_A; w_B) waited on the previous part's 8-byte stores
+// (perf on pyramid20: a tenth of the friction pair's samples on that one load; issue 18). Inline, GCC keeps them
+// in registers. Same operations in the same order, so the same results.
+#if defined(__GNUC__)
+#define SCREE_VISIT_INLINE __attribute__((always_inline))
+#define SCREE_VISIT_NOINLINE __attribute__((noinline))
+#else
+#define SCREE_VISIT_INLINE
+#define SCREE_VISIT_NOINLINE
+#endif
+
 namespace {
 
 /// True when rows [i, i + 3 + n) are a manifold of the compact form (contact_rows.cpp builds them so).
@@ -761,20 +774,18 @@ struct VisitBodies {
   bool hasA, hasB;
   VisitBodies(const PgsBlocks::Manifold& m, const std::vector<SolverBodyState>& bodies)
       : hasA(m.a >= 0), hasB(m.b >= 0) {
-    if (hasA) {
-      vA = bodies[size_t(m.a)].v;
-      w.head<3>() = bodies[size_t(m.a)].w;
-    } else {
-      vA.setZero();
-      w.head<3>().setZero();
-    }
-    if (hasB) {
-      vB = bodies[size_t(m.b)].v;
-      w.tail<3>() = bodies[size_t(m.b)].w;
-    } else {
-      vB.setZero();
-      w.tail<3>().setZero();
-    }
+    const Vec3 zero = Vec3::Zero();
+    const Vec3& wA = hasA ? bodies[size_t(m.a)].w : zero;
+    const Vec3& wB = hasB ? bodies[size_t(m.b)].w : zero;
+    vA = hasA ? bodies[size_t(m.a)].v : zero;
+    vB = hasB ? bodies[size_t(m.b)].v : zero;
+    // (w_A; w_B) written as the three aligned pairs the rows' 6-vector dots load (w_A.z and w_B.x share one):
+    // written as two 3-vectors, two of those loads each spanned two stores, which the CPU cannot forward (perf on
+    // pyramid20: 6 % of the visit's samples on one such load; issue 18).
+    using Vec2 = Eigen::Matrix<Real, 2, 1>;
+    w.segment<2>(0) = Vec2(wA.x(), wA.y());
+    w.segment<2>(2) = Vec2(wA.z(), wB.x());
+    w.segment<2>(4) = Vec2(wB.y(), wB.z());
   }
   void store(const PgsBlocks::Manifold& m, std::vector<SolverBodyState>& bodies) const {
     if (hasA) {
@@ -796,15 +807,15 @@ struct VisitBodies {
 };
 
 /// The friction rows of a compact manifold, forward (t1/t2, twist) or backward (twist, t2/t1); solveUnit's law.
-Real compactFriction(PgsBlocks::Manifold& m, VisitBodies& V, bool forward) {
+SCREE_VISIT_INLINE inline Real compactFriction(PgsBlocks::Manifold& m, VisitBodies& V, bool forward) {
   Real maxDelta = 0;
   // The bound's sum of positive normal impulses, kept with the impulses (boundingNormal's sum).
   const Real sumN = m.sumN;
   // Row k (0 t1, 1 t2, 2 twist: no linear part).
-  auto velocity = [&](int k) {
+  auto velocity = [&](int k) SCREE_VISIT_INLINE {
     return k < 2 ? V.rowVelocity(m.lin[1 + k], m.ang[3 + k]) : m.ang[5].dot(V.w);
   };
-  auto scalar = [&](int k, Real mu) {
+  auto scalar = [&](int k, Real mu) SCREE_VISIT_INLINE {
     const Real lim = frictionLimit(mu, sumN);
     const Real delta = (m.rhs[k] - velocity(k) - m.e[k] * m.lambda[k]) * m.invDiag[k];
     const Real nl = std::clamp(m.lambda[k] + delta, -lim, lim);
@@ -814,7 +825,7 @@ Real compactFriction(PgsBlocks::Manifold& m, VisitBodies& V, bool forward) {
     if (k < 2) V.push(m, m.lin[1 + k], d);
     maxDelta = std::max(maxDelta, std::abs(d));
   };
-  auto pair = [&]() {
+  auto pair = [&]() SCREE_VISIT_INLINE {
     Real d1 = (m.rhs[0] - velocity(0) - m.e[0] * m.lambda[0]) * m.invDiag[0];
     Real d2 = (m.rhs[1] - velocity(1) - m.e[1] * m.lambda[1]) * m.invDiag[1];
     Real l1 = m.lambda[0] + d1, l2 = m.lambda[1] + d2;
@@ -848,9 +859,14 @@ Real compactFriction(PgsBlocks::Manifold& m, VisitBodies& V, bool forward) {
 
 }  // namespace
 
+static Real compactBlockFallback(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<ConstraintRow>& rows,
+                                 std::vector<SolverBodyState>& bodies, VisitBodies& V, bool forward);
+
 /// The normal block of a compact manifold (solvePreparedBlock's law, both bodies free).
-static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<ConstraintRow>& rows,
-                         std::vector<SolverBodyState>& bodies, VisitBodies& V, bool forward) {
+SCREE_VISIT_INLINE static inline Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m,
+                                                   std::vector<ConstraintRow>& rows,
+                                                   std::vector<SolverBodyState>& bodies, VisitBodies& V,
+                                                   bool forward) {
   PgsBlocks::Point* P = pb.points.data() + m.point;
   const int n = m.n;
   if (m.ok) {
@@ -891,8 +907,17 @@ static Real compactBlock(PgsBlocks& pb, PgsBlocks::Manifold& m, std::vector<Cons
       }
     }
   }
-  // A bound is hit (or the block is singular): the ConstraintRow path on this manifold's normal rows, on the
-  // stored velocities.
+  return compactBlockFallback(pb, m, rows, bodies, V, forward);
+}
+
+/// compactBlock when a bound is hit (or the block is singular): the ConstraintRow path on this manifold's normal
+/// rows, on the stored velocities. Rare, so out of line.
+SCREE_VISIT_NOINLINE static Real compactBlockFallback(PgsBlocks& pb, PgsBlocks::Manifold& m,
+                                                           std::vector<ConstraintRow>& rows,
+                                                           std::vector<SolverBodyState>& bodies, VisitBodies& V,
+                                                           bool forward) {
+  PgsBlocks::Point* P = pb.points.data() + m.point;
+  const int n = m.n;
   V.store(m, bodies);
   const size_t first = m.row + 3;
   // The rows keep the shared body indices while the partitioned sweeps run on their own copy of the bodies
