@@ -600,10 +600,10 @@ static Real sweepRows(std::vector<ConstraintRow>& rows, std::vector<SolverBodySt
 // (fitsCompactLayout) keeps the ConstraintRow sweeps. PgsSolver::prepare clears the records, so a path that does
 // not rebuild them (the hybrid and coloured sweeps) never reads last step's.
 // The manifold visit's parts (VisitBodies, compactFriction and its lambdas, compactBlock's accepted update) are
-// forced inline into the visit: out of line, the bodies' velocities in VisitBodies went through memory between
-// the parts, and each part's first 16-byte load of (w_A; w_B) waited on the previous part's 8-byte stores
-// (perf on pyramid20: a tenth of the friction pair's samples on that one load; issue 18). Inline, GCC keeps them
-// in registers. Same operations in the same order, so the same results.
+// forced inline into the visit, and compactBlock's rare fallback is kept out of line. With VisitBodies writing
+// (w_A; w_B) in the pairs its dots load (below), that took pyramid20's solve stage from 0.480 to 0.442-0.454 ms
+// per step; the store pattern alone gave 0.467, the inlining alone nothing (interleaved rounds, issue 18,
+// docs/solver-internals.md "Loads that wait on stores"). Same operations in the same order, so the same results.
 #if defined(__GNUC__)
 #define SCREE_VISIT_INLINE __attribute__((always_inline))
 #define SCREE_VISIT_NOINLINE __attribute__((noinline))
