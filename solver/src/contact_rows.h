@@ -109,11 +109,13 @@ class WarmStartCache {
   /// entries): a cursor walks the entries forward from the last pair's, so a step's lookups are one pass over the
   /// cache instead of a binary search each, whose first probes missed the cache (perf: 2.7 % of buildContactRows
   /// on pyramid20, issue 18). A pair below the cursor (contacts not in pair order) falls back to the binary
-  /// search. Start each pass with resetCursor(). The range is pairRange's.
+  /// search. Any cursor inside the entries gives pairRange's range (the entries before it are below the pair, or
+  /// the search falls back); one left past the end by a commit of fewer entries is clamped. Start each pass with
+  /// resetCursor(), so that it walks from the first entry.
   std::pair<const Entry*, const Entry*> pairRangeAscending(uint64_t pair) {
     const Entry* base = current_.data();
     const Entry* last = base + current_.size();
-    const Entry* it = base + cursor_;
+    const Entry* it = base + std::min(cursor_, current_.size());
     if (it != base && it[-1].pair >= pair) return pairRange(pair);  // behind the cursor
     // Forward: a few entries linearly (the next pair's are usually next), then a binary search of the rest.
     constexpr int kLinear = 8;
@@ -166,7 +168,6 @@ class WarmStartCache {
       next_[j] = e;
     }
     std::swap(current_, next_);
-    cursor_ = 0;
   }
 
  private:
