@@ -463,28 +463,102 @@ static bool solveNormalBlock(std::vector<ConstraintRow>& rows, std::vector<Solve
   return true;
 }
 
-void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, PgsBlocks* blocks) {
+// M^-1 J^T and the diagonal of one row.
+static inline void prepareRow(ConstraintRow& r, const std::vector<SolverBodyState>& bodies) {
+  SCREE_ASSERT(r.bodyA < int32_t(bodies.size()) && r.bodyB < int32_t(bodies.size()));
+  const SolverBodyState& A = r.bodyA >= 0 ? bodies[r.bodyA] : kStatic;
+  const SolverBodyState& B = r.bodyB >= 0 ? bodies[r.bodyB] : kStatic;
+  r.mJLinA = A.invMass * r.jLinA;
+  r.mJAngA = A.invInertia * r.jAngA;
+  r.mJLinB = B.invMass * r.jLinB;
+  r.mJAngB = B.invInertia * r.jAngB;
+  Real k = r.e;
+  if (r.bodyA >= 0) k += r.jLinA.dot(r.mJLinA) + r.jAngA.dot(r.mJAngA);
+  if (r.bodyB >= 0) k += r.jLinB.dot(r.mJLinB) + r.jAngB.dot(r.mJAngB);
+  r.diag = k;
+  r.invDiag = k > 0 ? 1.0 / k : 0.0;
+}
+
+// The rows of the normal block starting at `first`, prepared on first use when PgsSolver::prepare deferred them
+// (PgsBlocks::Block::rowsReady). `bodies` is the array the rows' body indices point into at the call (the
+// partitioned sweeps' local copies hold the same masses and inertias).
+static void ensureBlockRows(std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                            size_t first, const PgsBlocks* blocks) {
+  const int32_t slot = rows[first].blockSlot;
+  if (!blocks || slot < 0) return;
+  const PgsBlocks::Block& B = blocks->blocks[size_t(slot)];
+  if (B.rowsReady) return;
+  for (size_t k = first; k < first + size_t(rows[first].blockCount); ++k) prepareRow(rows[k], bodies);
+  B.rowsReady = true;
+}
+
+// Every deferred block of rows [begin, end) (block rows are contiguous and begin at their first row).
+static void ensureBlockRows(std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                            size_t begin, size_t end, const PgsBlocks* blocks) {
+  if (!blocks) return;
+  for (size_t i = begin; i < end; ++i)
+    if (rows[i].blockCount > 1 && rows[i].blockBegin == int32_t(i)) ensureBlockRows(rows, bodies, i, blocks);
+}
+
+void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, PgsBlocks* blocks,
+                        bool deferBlockRows) {
   // One pass over the rows: each row's M^-1 J^T and diagonal, then its warm-start impulse (row order, as the
   // sweeps' bodies expect; the blocks below read only masses and inertias, so building them afterwards gives the
   // same bits). The rows are about 300 bytes each: a second pass cost pyramid20 about 1 % (issue 18).
+  //
+  // DESIGN (issue 18, deferred block rows; docs/solver-internals.md "Rows prepared on first use"): the compact
+  // sweeps read a manifold's normal rows only through its block (G_a, W_a) and its points; their own M^-1 J^T
+  // and diagonals serve only the rare paths that leave the block (a bound hit, the shock pass's fallback
+  // sweeps). With deferBlockRows they are left to those paths (ensureBlockRows), and the block's warm start is
+  // applied per body: M^-1 (sum_i lambda_i J_i^T), the same impulse as the rows' one by one in another order
+  // of summation (last bits).
   if (blocks) blocks->starts.clear();
   for (size_t i = 0; i < rows.size(); ++i) {
     ConstraintRow& r = rows[i];
-    SCREE_ASSERT(r.bodyA < int32_t(bodies.size()) && r.bodyB < int32_t(bodies.size()));
     SCREE_VALIDATE_CHECK(r.jLinA.allFinite() && r.jAngA.allFinite() && r.jLinB.allFinite() && r.jAngB.allFinite());
-    const SolverBodyState& A = r.bodyA >= 0 ? bodies[r.bodyA] : kStatic;
-    const SolverBodyState& B = r.bodyB >= 0 ? bodies[r.bodyB] : kStatic;
-    r.mJLinA = A.invMass * r.jLinA;
-    r.mJAngA = A.invInertia * r.jAngA;
-    r.mJLinB = B.invMass * r.jLinB;
-    r.mJAngB = B.invInertia * r.jAngB;
-    Real k = r.e;
-    if (r.bodyA >= 0) k += r.jLinA.dot(r.mJLinA) + r.jAngA.dot(r.mJAngA);
-    if (r.bodyB >= 0) k += r.jLinB.dot(r.mJLinB) + r.jAngB.dot(r.mJAngB);
-    r.diag = k;
-    r.invDiag = k > 0 ? 1.0 / k : 0.0;
+    if (blocks && r.blockCount > 1 && r.blockBegin == int32_t(i)) {
+      const size_t n = size_t(r.blockCount);
+      const uint32_t slot = uint32_t(blocks->starts.size());
+      blocks->starts.push_back(uint32_t(i));
+      if (blocks->blocks.size() <= slot) blocks->blocks.resize(slot + 1);  // grows only: reused across steps
+      bool defer = deferBlockRows && i + n <= rows.size();
+      for (size_t k = i + 1; defer && k < i + n; ++k)
+        defer = rows[k].bodyA == r.bodyA && rows[k].bodyB == r.bodyB && rows[k].blockBegin == int32_t(i);
+      blocks->blocks[slot].rowsReady = !defer;
+      if (defer) {
+        SCREE_ASSERT(r.bodyA < int32_t(bodies.size()) && r.bodyB < int32_t(bodies.size()));
+        Vec3 lA = Vec3::Zero(), aA = Vec3::Zero(), lB = Vec3::Zero(), aB = Vec3::Zero();
+        bool warm = false;
+        for (size_t k = i; k < i + n; ++k) {
+          ConstraintRow& q = rows[k];
+          SCREE_VALIDATE_CHECK(q.jLinA.allFinite() && q.jAngA.allFinite() && q.jLinB.allFinite() &&
+                               q.jAngB.allFinite());
+          q.blockSlot = -1;
+          if (q.lambda == 0) continue;
+          warm = true;
+          lA += q.lambda * q.jLinA;
+          aA += q.lambda * q.jAngA;
+          lB += q.lambda * q.jLinB;
+          aB += q.lambda * q.jAngB;
+        }
+        if (warm) {
+          if (r.bodyA >= 0) {
+            SolverBodyState& A = bodies[size_t(r.bodyA)];
+            A.v += A.invMass * lA;
+            A.w += A.invInertia * aA;
+          }
+          if (r.bodyB >= 0) {
+            SolverBodyState& B = bodies[size_t(r.bodyB)];
+            B.v += B.invMass * lB;
+            B.w += B.invInertia * aB;
+          }
+        }
+        i += n - 1;
+        continue;
+      }
+    }
+    prepareRow(r, bodies);
     r.blockSlot = -1;
-    if (blocks && r.blockCount > 1 && r.blockBegin == int32_t(i)) blocks->starts.push_back(uint32_t(i));
     if (r.lambda != 0) applyImpulse(r, r.lambda, bodies);
   }
   if (blocks) {
@@ -493,7 +567,6 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     blocks->points.clear();
     blocks->plan.clear();
     const size_t count = blocks->starts.size();
-    if (blocks->blocks.size() < count) blocks->blocks.resize(count);  // grows only: storage reused across steps
     for (size_t slot = 0; slot < count; ++slot) {
       const uint32_t i = blocks->starts[slot];
       buildBlock(rows.data() + i, bodies, blocks->blocks[slot]);
@@ -730,8 +803,7 @@ bool compactUnit(const std::vector<ConstraintRow>& rows, const PgsBlocks& pb, si
   return isCompactManifold(rows, i, n) && fitsCompactLayout(rows, i, n, pb.blocks[size_t(rows[i + 3].blockSlot)]);
 }
 
-void buildCompact(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
-                  PgsBlocks& pb) {
+void buildCompact(std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies, PgsBlocks& pb) {
   pb.manifolds.clear();
   pb.points.clear();
   pb.plan.clear();
@@ -740,6 +812,8 @@ void buildCompact(const std::vector<ConstraintRow>& rows, const std::vector<Solv
   for (size_t i = 0; i < rows.size();) {
     int n = 0;
     if (!compactUnit(rows, pb, i, n)) {
+      // Swept as ConstraintRows: a deferred normal block's rows are prepared now (PgsSolver::prepare).
+      if (rows[i].blockCount > 1) ensureBlockRows(rows, bodies, i, &pb);
       i += unitSpan(rows, i);
       continue;
     }
@@ -929,6 +1003,7 @@ SCREE_VISIT_NOINLINE static Real compactBlockFallback(PgsBlocks& pb, PgsBlocks::
     r.bodyA = m.a;
     r.bodyB = m.b;
   }
+  ensureBlockRows(rows, bodies, first, &pb);  // the rows' M^-1 J^T, if PgsSolver::prepare deferred them
   Real maxDelta = 0, d = 0;
   if (solveNormalBlock(rows, bodies, first, -1, d, &pb)) {
     maxDelta = d;
@@ -1346,6 +1421,7 @@ void PgsSolver::shockRange(std::vector<ConstraintRow>& rows, std::vector<SolverB
       return;
     }
   }
+  ensureBlockRows(rows, bodies, sr.begin, sr.begin + sr.count, blocks);  // the sweeps read the rows' M^-1 J^T
   for (int sweep = 0; sweep < maxSweeps; ++sweep) {
     Real change = 0, scale = 0;
     sweepRange(sr, change, scale);
@@ -1409,6 +1485,9 @@ void PgsSolver::colour(const std::vector<ConstraintRow>& rows, const std::vector
 
 Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
                         const PgsBlocks* blocks, PgsColouring& c) {
+  // The coloured sweeps read every row: any normal block whose rows PgsSolver::prepare deferred is prepared
+  // first (solve_stage.cpp does not defer for this path; a caller that did pays here).
+  ensureBlockRows(rows, bodies, 0, rows.size(), blocks);
   // Private copies of static bodies: one per (unit, side) that reads one.
   const size_t numBodies = bodies.size();
   c.remapped.clear();
@@ -1601,6 +1680,8 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   for (int g = 0; g < R; ++g)
     forUnitsOf(g, [&](uint32_t u) {
       if (p.unitManifold[u] >= 0) return;
+      // Swept as ConstraintRows: a deferred normal block's rows are prepared first, on the shared bodies.
+      ensureBlockRows(rows, bodies, p.order[u].begin, p.order[u].begin + p.order[u].count, blocks);
       for (uint32_t i = p.order[u].begin; i < p.order[u].begin + p.order[u].count; ++i)
         for (int32_t* b : {&rows[i].bodyA, &rows[i].bodyB})
           if (*b >= 0 && size_t(*b) < nb) *b = p.localOf[size_t(g) * nb + size_t(*b)];

@@ -313,11 +313,17 @@ void solve(SimulationState& s) {
   }
   const bool split = classifyRows(s, particleDirect);
   if (!s.directSet.empty()) addGeometricStiffness(s);
-  if (!s.rows.empty()) PgsSolver::prepare(s.rows, s.sb, &s.pgsBlocks);
+  // The normal blocks' rows are prepared on first use (PgsSolver::prepare, deferBlockRows) on the paths whose
+  // sweeps read them only through the blocks: the serial and partitioned sweeps of ITERATIVE and INTERLEAVED.
+  // HYBRID's subset sweeps and direct solve and the coloured sweeps read every row.
+  const SolvePath path = choosePath(s);
+  const bool deferBlockRows = (path == SolvePath::ITERATIVE || path == SolvePath::INTERLEAVED) &&
+                              (s.solver.getUsePartitionedSweeps() || !s.solver.getUseColouredSweeps());
+  if (!s.rows.empty()) PgsSolver::prepare(s.rows, s.sb, &s.pgsBlocks, deferBlockRows);
   if (particleDirect) s.particles.loadDirectImpulses(s.rows);
   else if (particles) s.particles.prepare(s.granular, s.sb);
 
-  switch (choosePath(s)) {
+  switch (path) {
     case SolvePath::NOTHING: break;
     case SolvePath::HYBRID:
       if (particleDirect && s.particles.needsLumpRounds()) lumpPath(s);

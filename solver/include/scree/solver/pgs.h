@@ -47,6 +47,11 @@ struct PgsBlocks {
     mutable bool ok[3];
     mutable bool built[3];
     bool axisU, axisV;
+    /// False while the block's ConstraintRows lack M^-1 J^T and their diagonals: PgsSolver::prepare with
+    /// deferBlockRows leaves them to the first path that reads them (ensureBlockRows in pgs.cpp: a visit's
+    /// bound-hit fallback, the shock pass's fallback sweeps, a non-compact manifold's row sweeps). Mutable like
+    /// sInv, and for the same reason: one thread per block at a time.
+    mutable bool rowsReady = true;
   };
   std::vector<Block> blocks;
   std::vector<uint32_t> starts;  ///< PgsSolver::prepare: each block's first row, in row order (slot order)
@@ -186,8 +191,13 @@ class PgsSolver {
  public:
   /// Computes M^-1 J^T and the diagonals, then applies the warm-start impulses to the velocities. With `blocks`,
   /// also the manifold normal blocks' operators (ConstraintRow::blockSlot); without, every blockSlot is -1.
+  /// With `blocks` and deferBlockRows, the normal blocks' rows get neither (PgsBlocks::Block::rowsReady false):
+  /// their warm start is applied per body as M^-1 (sum_i lambda_i J_i^T), and the paths that read the rows'
+  /// M^-1 J^T prepare a block's rows on first use. Only for the iterate overloads that take `blocks` (serial and
+  /// partitioned; the coloured one prepares every deferred block at entry) and the shock pass; not for the
+  /// subset sweeps nor DIRECT, which read the rows directly.
   static void prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
-                      PgsBlocks* blocks = nullptr);
+                      PgsBlocks* blocks = nullptr, bool deferBlockRows = false);
   /// `iterations` sweeps over all rows in order. Returns the largest |delta lambda| of the last sweep. `blocks`
   /// must be the one given to prepare (or null).
   /// With `blocks`, manifold contacts are swept from compact copies (PgsBlocks::Manifold) built at entry and
