@@ -872,9 +872,9 @@ struct VisitBodies {
     }
   }
   /// J v of a row with A-side linear part l and angular part [A; B] ang.
-  Real rowVelocity(const Vec3& l, const Vec6& ang) const { return l.dot(vA - vB) + ang.dot(w); }
+  SCREE_VISIT_INLINE Real rowVelocity(const Vec3& l, const Vec6& ang) const { return l.dot(vA - vB) + ang.dot(w); }
   /// The linear velocity change of an impulse d along the A-side direction l.
-  void push(const PgsBlocks::Manifold& m, const Vec3& l, Real d) {
+  SCREE_VISIT_INLINE void push(const PgsBlocks::Manifold& m, const Vec3& l, Real d) {
     vA += (m.imA * d) * l;
     vB -= (m.imB * d) * l;
   }
