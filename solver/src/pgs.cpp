@@ -874,9 +874,14 @@ struct VisitBodies {
   /// J v of a row with A-side linear part l and angular part [A; B] ang.
   SCREE_VISIT_INLINE Real rowVelocity(const Vec3& l, const Vec6& ang) const { return l.dot(vA - vB) + ang.dot(w); }
   /// The linear velocity change of an impulse d along the A-side direction l.
+  /// Written per component: as `vA += (m.imA * d) * l`, GCC called Eigen's assignment loop out of line from
+  /// the visit (a call per push, its operands through memory). The same products, so the same bits.
   SCREE_VISIT_INLINE void push(const PgsBlocks::Manifold& m, const Vec3& l, Real d) {
-    vA += (m.imA * d) * l;
-    vB -= (m.imB * d) * l;
+    const Real ka = m.imA * d, kb = m.imB * d;
+    for (int k = 0; k < 3; ++k) {
+      vA[k] += ka * l[k];
+      vB[k] -= kb * l[k];
+    }
   }
 };
 
