@@ -868,7 +868,11 @@ struct VisitBodies {
     }
     if (hasB) {
       bodies[size_t(m.b)].v = vB;
-      bodies[size_t(m.b)].w = w.tail<3>();
+      // w_B as the pair (w_B.y, w_B.z) the visit stored and w_B.x from the pair before: read as w.tail<3>(),
+      // GCC loaded (w_B.x, w_B.y) as one pair across two stores (perf: the visit's hottest load; issue 18).
+      SolverBodyState& B = bodies[size_t(m.b)];
+      B.w.x() = w[3];
+      B.w.tail<2>() = w.segment<2>(4);
     }
   }
   /// J v of a row with A-side linear part l and angular part [A; B] ang.
