@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <random>
 #include <utility>
 
@@ -491,8 +493,10 @@ TEST_CASE("persistent box-box manifolds: every pair of a resting pile is found a
   space.collide(1.0 / 60, first);
   CHECK(space.getNumReusedManifolds() == 0);
   REQUIRE(first.size() == 13);  // 6 contacts up the column, 7 boxes on the slab
+  CHECK_FALSE(space.getBroadphase().lastCallReused());  // the first call bins
   space.collide(1.0 / 60, second);
   CHECK(space.getNumReusedManifolds() == 13);
+  CHECK(space.getBroadphase().lastCallReused());  // nothing moved: the kept candidates (on by default)
   REQUIRE(second.size() == first.size());
   for (size_t c = 0; c < first.size(); ++c) {
     REQUIRE(second[c].points().size() == first[c].points().size());
@@ -502,5 +506,124 @@ TEST_CASE("persistent box-box manifolds: every pair of a resting pile is found a
       CHECK(std::abs(second[c].points()[k].depth - first[c].points()[k].depth) < 1e-12);
       CHECK(second[c].points()[k].featureId == first[c].points()[k].featureId);
     }
+  }
+}
+
+TEST_CASE("broadphase reuse returns the fresh grid's pairs in the same order while boxes move, jump and vanish") {
+  // A grid that keeps its candidates (UniformGrid::setReuseRatio) against one that bins every call, over a run
+  // of calls in which most boxes drift by micrometres (reuse), some jump by metres (the next call bins afresh),
+  // one box is empty now and then and the number of boxes changes: the pairs must be identical, element for
+  // element, on every call. Both sizes: the cells (300 boxes and two unbounded ones) and all pairs (20).
+  for (const size_t n : {size_t(300), size_t(20)}) {
+    CAPTURE(n);
+    std::mt19937 rng(1234 + uint32_t(n));
+    std::uniform_real_distribution<Real> unit(0, 1), jitter(-2e-6, 2e-6), jump(-3, 3);
+    std::vector<Aabb> boxes = randomBoxes(rng, n, Sizes::MIXED, n > 100 ? 6.0 : 2.0);
+    if (n > 100) {
+      Aabb plane;  // unbounded, as Space gives a plane
+      plane.lo = Vec3(-1e300, -1e300, -1e300);
+      plane.hi = Vec3(1e300, 1e300, -5.0);
+      boxes.push_back(plane);
+      Aabb slab = boxAt(Vec3(0, 0, 0), Vec3(50, 50, 0.2));  // oversize
+      boxes.push_back(slab);
+    }
+    UniformGrid kept(0.05), fresh;
+    int reused = 0, binned = 0;
+    PairList a, b;
+    for (int call = 0; call < 400; ++call) {
+      CAPTURE(call);
+      const Real r = unit(rng);
+      if (r < 0.05) {  // a jump: leaves its enlarged box
+        const size_t i = size_t(unit(rng) * Real(boxes.size() - 1));
+        const Vec3 d(jump(rng), jump(rng), jump(rng));
+        boxes[i].lo += d;
+        boxes[i].hi += d;
+      } else if (r < 0.07) {  // one box empty for this call: inverted on one axis only, so that enlarging it
+        // would give a box that is not empty (and the grid must not keep candidates found with it)
+        const size_t i = size_t(unit(rng) * Real(boxes.size() - 1));
+        const Aabb saved = boxes[i];
+        boxes[i].hi.x() = boxes[i].lo.x() - 1e-3;
+        kept.findPairs(boxes, a);
+        fresh.findPairs(boxes, b);
+        CHECK_FALSE(kept.lastCallReused());
+        REQUIRE(a == b);
+        kept.findPairs(boxes, a);  // still empty: binned again
+        CHECK_FALSE(kept.lastCallReused());
+        REQUIRE(a == b);
+        boxes[i] = saved;
+      } else if (r < 0.08) {  // a box added or removed
+        if (unit(rng) < 0.5) boxes.push_back(boxAt(Vec3(jump(rng), jump(rng), jump(rng)), Vec3::Constant(0.3)));
+        else boxes.pop_back();
+      }
+      for (Aabb& box : boxes) {  // everything drifts
+        if (std::abs(box.lo.x()) > 1e299) continue;
+        const Vec3 d(jitter(rng), jitter(rng), jitter(rng));
+        box.lo += d;
+        box.hi += d;
+      }
+      kept.findPairs(boxes, a);
+      fresh.findPairs(boxes, b);
+      REQUIRE(a == b);
+      (kept.lastCallReused() ? reused : binned) += 1;
+      CHECK_FALSE(fresh.lastCallReused());
+    }
+    // Both paths ran: most calls reuse, the jumps and resizes bin afresh.
+    CHECK(reused > 250);
+    CHECK(binned > 10);
+    REQUIRE(b.size() > n / 20);  // the pairs are not trivially empty
+  }
+}
+
+TEST_CASE("broadphase reuse backs off while every call moves the boxes and resumes when they rest") {
+  // Boxes that jump on every call leave their enlarged boxes each time: the grid then bins plainly for 1, 2, 4 ...
+  // 64 calls between tries (the pairs are the same either way), and once the boxes rest it reuses again within
+  // the longest back-off.
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<Real> jump(-2, 2);
+  std::vector<Aabb> boxes = randomBoxes(rng, 200, Sizes::UNIFORM, 5.0);
+  UniformGrid kept(0.05), fresh;
+  PairList a, b;
+  int reused = 0;
+  for (int call = 0; call < 150; ++call) {
+    for (Aabb& box : boxes) {
+      const Vec3 d(jump(rng), jump(rng), jump(rng));
+      box.lo += d;
+      box.hi += d;
+    }
+    kept.findPairs(boxes, a);
+    fresh.findPairs(boxes, b);
+    REQUIRE(a == b);
+    reused += kept.lastCallReused();
+  }
+  CHECK(reused == 0);
+  int firstReuse = -1;
+  for (int call = 0; call < 70 && firstReuse < 0; ++call) {
+    kept.findPairs(boxes, a);
+    fresh.findPairs(boxes, b);
+    REQUIRE(a == b);
+    if (kept.lastCallReused()) firstReuse = call;
+  }
+  CHECK(firstReuse >= 0);
+  CHECK(firstReuse <= 66);  // at most 64 plain calls, one binning, then the first reuse
+}
+
+TEST_CASE("broadphase reuse ratio: bad values are rejected and leave the ratio unchanged; Space's default") {
+  UniformGrid grid(0.05);
+  for (const Real bad : {-0.1, std::nan(""), std::numeric_limits<Real>::infinity()}) {
+    CHECK_THROWS_AS(grid.setReuseRatio(bad), std::invalid_argument);
+    CHECK(grid.getReuseRatio() == 0.05);
+  }
+  Space space;
+  CHECK(space.getBroadphaseReuseRatio() == Space::kDefaultBroadphaseReuseRatio);
+  CHECK_THROWS_AS(space.setBroadphaseReuseRatio(-1), std::invalid_argument);
+  CHECK(space.getBroadphaseReuseRatio() == Space::kDefaultBroadphaseReuseRatio);
+  // Off: the same boxes bin on every call.
+  grid.setReuseRatio(0);
+  const std::vector<Aabb> boxes = {boxAt(Vec3::Zero(), Vec3::Constant(1)), boxAt(Vec3(1, 0, 0), Vec3::Constant(1))};
+  PairList pairs;
+  for (int k = 0; k < 3; ++k) {
+    grid.findPairs(boxes, pairs);
+    CHECK_FALSE(grid.lastCallReused());
+    CHECK(pairs == PairList{{0, 1}});
   }
 }

@@ -71,7 +71,83 @@ void UniformGrid::setOversizeFactor(Real f) {
   oversizeFactor_ = f;
 }
 
+void UniformGrid::setReuseRatio(Real r) {
+  if (!(std::isfinite(r) && r >= 0)) detail::throwInvalid("UniformGrid::setReuseRatio", "ratio", r, "must be finite and >= 0");
+  reuseRatio_ = r;
+  haveKept_ = false;
+  backoff_ = skip_ = 0;
+}
+
+// DESIGN (issue 18, broadphase reuse; docs/solver-internals.md "Broadphase reuse"): a resting scene's boxes move
+// by micrometres per step, yet binning, sorting and the owner-cell tests ran every step (findPairs and its
+// radix sorts: about 5 % of pyramid20's step). As Box2D's enlarged AABBs, but all or nothing: the candidates are
+// the pairs of enlarged boxes, found by the grid when any box leaves its enlarged box, and each call keeps those
+// whose boxes overlap now. Containment is tested with the same <= comparisons as Aabb::overlaps, so a pair that
+// overlaps now is among the candidates exactly (lo_e <= lo <= hi' <= hi'_e on every axis), and the candidates
+// are sorted like the grid's output: the pairs and their order do not change, only the work.
 void UniformGrid::findPairs(const std::vector<Aabb>& boxes, std::vector<std::pair<uint32_t, uint32_t>>& outPairs) {
+  lastReused_ = false;
+  if (!(reuseRatio_ > 0)) {
+    findPairsExact(boxes, outPairs);
+    return;
+  }
+  const size_t n = boxes.size();
+  auto inside = [](const Aabb& b, const Aabb& e) {
+    return e.lo.x() <= b.lo.x() && e.lo.y() <= b.lo.y() && e.lo.z() <= b.lo.z() && b.hi.x() <= e.hi.x() &&
+           b.hi.y() <= e.hi.y() && b.hi.z() <= e.hi.z();
+  };
+  // Back-off: when the candidates found by the last binning were not reused even once (the boxes move faster than
+  // their enlargement allows), the next calls bin the boxes themselves, 1, 2, 4 ... 64 calls before trying
+  // again, so that a scene in motion pays little more than the containment test for the option.
+  if (skip_ > 0) {
+    --skip_;
+    haveKept_ = false;
+    findPairsExact(boxes, outPairs);
+    return;
+  }
+  bool reuse = haveKept_ && enlarged_.size() == n;
+  for (size_t i = 0; reuse && i < n; ++i) reuse = !isEmpty(boxes[i]) && inside(boxes[i], enlarged_[i]);
+  if (reuse) {
+    backoff_ = 0;
+    usedKept_ = true;
+  } else if (haveKept_ && !usedKept_) {
+    backoff_ = backoff_ == 0 ? 1 : std::min(2 * backoff_, 64);
+    skip_ = backoff_ - 1;
+    haveKept_ = false;
+    findPairsExact(boxes, outPairs);
+    return;
+  }
+  if (!reuse) {
+    // Bin afresh: the enlarged boxes' pairs become the candidates (none kept while a box is empty: an empty
+    // box enlarged may not be empty).
+    haveKept_ = false;
+    enlarged_.resize(n);
+    bool empty = false;
+    for (size_t i = 0; i < n; ++i) {
+      Aabb e = boxes[i];
+      empty = empty || isEmpty(e);
+      e.inflate(reuseRatio_ * e.extent().maxCoeff());
+      enlarged_[i] = e;
+    }
+    if (empty) {
+      findPairsExact(boxes, outPairs);
+      return;
+    }
+    findPairsExact(enlarged_, candidates_);
+    haveKept_ = true;
+    usedKept_ = false;
+  } else {
+    lastReused_ = true;
+    numCellEntries_ = 0;
+    numCandidateTests_ = candidates_.size();
+  }
+  outPairs.clear();
+  for (const auto& [i, j] : candidates_)
+    if (boxes[i].overlaps(boxes[j])) outPairs.emplace_back(i, j);
+}
+
+void UniformGrid::findPairsExact(const std::vector<Aabb>& boxes,
+                                 std::vector<std::pair<uint32_t, uint32_t>>& outPairs) {
   outPairs.clear();
   cellKeys_.clear();
   cellItems_.clear();

@@ -66,13 +66,23 @@ class Space {
   /// Box-box pairs whose manifold was reused (not clipped again) in the last collide().
   size_t getNumReusedManifolds() const { return numReused_; }
 
+  // ---- issue 18 (broadphase reuse; docs/solver-internals.md "Broadphase reuse") ----
+  /// The broadphase keeps its candidate pairs from step to step while every geometry's AABB stays inside a copy
+  /// enlarged by this ratio of its largest extent on every side (default 0.05; 0 turns reuse off). The pairs and
+  /// their order are the same either way; a resting scene skips the binning and sorting, and a scene whose
+  /// bodies move bins afresh whenever one leaves its enlarged box (UniformGrid::setReuseRatio). Throws
+  /// std::invalid_argument unless ratio is finite and >= 0.
+  void setBroadphaseReuseRatio(Real ratio) { grid_.setReuseRatio(ratio); }
+  Real getBroadphaseReuseRatio() const { return grid_.getReuseRatio(); }
+  static constexpr Real kDefaultBroadphaseReuseRatio = 0.05;
+
  private:
   static uint64_t pairKey(uint32_t a, uint32_t b) {
     return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
   }
   std::vector<GeometryRef> geoms_;
   std::set<uint64_t> disabledGroups_, disabledGeoms_, disabledBodies_;
-  detail::UniformGrid grid_;
+  detail::UniformGrid grid_{kDefaultBroadphaseReuseRatio};
   Real margin_ = 1e-3;
   size_t numPairs_ = 0;
   // scratch

@@ -21,6 +21,9 @@ namespace scree::detail {
 
 class UniformGrid {
  public:
+  UniformGrid() = default;
+  /// A grid whose findPairs() reuses its candidates (setReuseRatio).
+  explicit UniformGrid(Real reuseRatio) { setReuseRatio(reuseRatio); }
   /// 0 (default) = automatic from the box sizes.
   void setCellSize(Real size);
   Real getCellSize() const { return cellSize_; }
@@ -34,6 +37,18 @@ class UniformGrid {
   /// All pairs (i, j), i < j, whose boxes overlap, sorted. Boxes with lo > hi (empty) are skipped.
   void findPairs(const std::vector<Aabb>& boxes, std::vector<std::pair<uint32_t, uint32_t>>& outPairs);
 
+  /// Reuse between calls (issue 18; 0, the default, turns it off). With a ratio r > 0, findPairs() finds its
+  /// candidates among boxes enlarged by r times their largest extent on every side, keeps them, and on later
+  /// calls, while every box is non-empty and lies inside its enlarged box, returns the kept candidates whose
+  /// boxes overlap now, without binning or sorting. The pairs and their order are findPairs()'s either way:
+  /// two boxes that overlap lie inside enlarged boxes that overlap. A box that leaves its enlarged box, a change
+  /// in the number of boxes or an empty box makes the next call bin afresh. Space turns it on (space.cpp).
+  /// Throws std::invalid_argument unless r is finite and >= 0.
+  void setReuseRatio(Real r);
+  Real getReuseRatio() const { return reuseRatio_; }
+  /// Whether the last findPairs() returned kept candidates (no binning).
+  bool lastCallReused() const { return lastReused_; }
+
   /// Work done by the last findPairs() (read-only, for tests and profiling). Cell entries: (cell, box) entries
   /// binned, after dropping a box's repeats within one hash bucket. Candidate tests: box pairs tested by AABB,
   /// i.e. pairs sharing a bucket plus every oversize box against the binned and the other oversize boxes.
@@ -41,6 +56,17 @@ class UniformGrid {
   size_t getNumCandidateTests() const { return numCandidateTests_; }
 
  private:
+  /// findPairs() without reuse.
+  void findPairsExact(const std::vector<Aabb>& boxes, std::vector<std::pair<uint32_t, uint32_t>>& outPairs);
+  Real reuseRatio_ = 0;
+  bool lastReused_ = false;
+  bool haveKept_ = false;
+  bool usedKept_ = false;  ///< the kept candidates were reused at least once since they were found
+  int backoff_ = 0;        ///< calls to bin plainly after kept candidates went unused (findPairs)
+  int skip_ = 0;           ///< of which still to go
+  std::vector<Aabb> enlarged_;                              ///< the boxes the kept candidates were found for
+  std::vector<std::pair<uint32_t, uint32_t>> candidates_;  ///< their overlapping pairs, sorted
+
   Real cellSize_ = 0;
   Real usedCellSize_ = 0;
   Real oversizeFactor_ = 8;
