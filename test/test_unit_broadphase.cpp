@@ -509,6 +509,23 @@ TEST_CASE("persistent box-box manifolds: every pair of a resting pile is found a
   }
 }
 
+namespace {
+void shift(Aabb& box, const Vec3& d) {
+  box.lo += d;
+  box.hi += d;
+}
+
+/// Both grids' pairs for `boxes`, required equal element for element; returns whether `kept` reused.
+bool samePairs(UniformGrid& kept, UniformGrid& fresh, const std::vector<Aabb>& boxes) {
+  PairList a, b;
+  kept.findPairs(boxes, a);
+  fresh.findPairs(boxes, b);
+  REQUIRE(a == b);
+  CHECK_FALSE(fresh.lastCallReused());
+  return kept.lastCallReused();
+}
+}  // namespace
+
 TEST_CASE("broadphase reuse returns the fresh grid's pairs in the same order while boxes move, jump and vanish") {
   // A grid that keeps its candidates (UniformGrid::setReuseRatio) against one that bins every call, over a run
   // of calls in which most boxes drift by micrometres (reuse), some jump by metres (the next call bins afresh),
@@ -535,9 +552,7 @@ TEST_CASE("broadphase reuse returns the fresh grid's pairs in the same order whi
       const Real r = unit(rng);
       if (r < 0.05) {  // a jump: leaves its enlarged box
         const size_t i = size_t(unit(rng) * Real(boxes.size() - 1));
-        const Vec3 d(jump(rng), jump(rng), jump(rng));
-        boxes[i].lo += d;
-        boxes[i].hi += d;
+        shift(boxes[i], Vec3(jump(rng), jump(rng), jump(rng)));
       } else if (r < 0.07) {  // one box empty for this call: inverted on one axis only, so that enlarging it
         // would give a box that is not empty (and the grid must not keep candidates found with it)
         const size_t i = size_t(unit(rng) * Real(boxes.size() - 1));
@@ -555,21 +570,14 @@ TEST_CASE("broadphase reuse returns the fresh grid's pairs in the same order whi
         if (unit(rng) < 0.5) boxes.push_back(boxAt(Vec3(jump(rng), jump(rng), jump(rng)), Vec3::Constant(0.3)));
         else boxes.pop_back();
       }
-      for (Aabb& box : boxes) {  // everything drifts
-        if (std::abs(box.lo.x()) > 1e299) continue;
-        const Vec3 d(jitter(rng), jitter(rng), jitter(rng));
-        box.lo += d;
-        box.hi += d;
-      }
-      kept.findPairs(boxes, a);
-      fresh.findPairs(boxes, b);
-      REQUIRE(a == b);
-      (kept.lastCallReused() ? reused : binned) += 1;
-      CHECK_FALSE(fresh.lastCallReused());
+      for (Aabb& box : boxes)  // everything drifts (the unbounded box stays)
+        if (std::abs(box.lo.x()) <= 1e299) shift(box, Vec3(jitter(rng), jitter(rng), jitter(rng)));
+      (samePairs(kept, fresh, boxes) ? reused : binned) += 1;
     }
     // Both paths ran: most calls reuse, the jumps and resizes bin afresh.
     CHECK(reused > 250);
     CHECK(binned > 10);
+    fresh.findPairs(boxes, b);
     REQUIRE(b.size() > n / 20);  // the pairs are not trivially empty
   }
 }
@@ -585,15 +593,8 @@ TEST_CASE("broadphase reuse backs off while every call moves the boxes and resum
   PairList a, b;
   int reused = 0;
   for (int call = 0; call < 150; ++call) {
-    for (Aabb& box : boxes) {
-      const Vec3 d(jump(rng), jump(rng), jump(rng));
-      box.lo += d;
-      box.hi += d;
-    }
-    kept.findPairs(boxes, a);
-    fresh.findPairs(boxes, b);
-    REQUIRE(a == b);
-    reused += kept.lastCallReused();
+    for (Aabb& box : boxes) shift(box, Vec3(jump(rng), jump(rng), jump(rng)));
+    reused += samePairs(kept, fresh, boxes);
   }
   CHECK(reused == 0);
   int firstReuse = -1;

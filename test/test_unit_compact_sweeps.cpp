@@ -74,40 +74,55 @@ int addManifold(std::vector<ConstraintRow>& rows, int a, int b, const Vec3& ca, 
 
 }  // namespace
 
+// Two unit boxes (mass 2) stacked on the static ground, the upper one tipping (w_x = 3 rad/s: its block update
+// leaves a corner's bound), a free row on the upper box before the manifolds and one after. Warm start on the lower
+// manifold's normals and friction; with `varied`, unequal warm starts on both manifolds' normals (so that a per-body
+// sum differs from one row's impulse times four) and unequal principal inertias.
+struct TippingStack {
+  std::vector<SolverBodyState> bodies = std::vector<SolverBodyState>(3);
+  std::vector<ConstraintRow> rows;
+  int m0 = 0, m1 = 0;
+  explicit TippingStack(bool varied) {
+    for (int i = 0; i < 2; ++i) {
+      bodies[size_t(i)].invMass = 0.5;
+      bodies[size_t(i)].invInertia = varied ? Mat3(Vec3(3.0, 2.0, 2.5).asDiagonal()) : Mat3(Mat3::Identity() * 3.0);
+    }
+    bodies[0].v = Vec3(0.2, -0.1, -0.5);
+    bodies[0].w = Vec3(0.05, 0, 0.1);
+    bodies[1].v = Vec3(0, 0.1, -0.2);
+    bodies[1].w = Vec3(3.0, 0.2, 0);
+    const Vec3 c0(0, 0, 0.5), c1(0.1, 0, 1.5);
+    ConstraintRow free1;
+    free1.bodyA = 1;
+    free1.jLinA = Vec3(0.3, 1, 0).normalized();
+    free1.rhs = 0.05;
+    free1.e = 1e-4;
+    rows.push_back(free1);
+    m0 = addManifold(rows, 0, -1, c0, Vec3::Zero(), Vec3(0, 0, 0), 0.5, 0.6);
+    m1 = addManifold(rows, 1, 0, c1, c0, Vec3(0.05, 0, 1.0), 0.45, 0.4);
+    ConstraintRow free2 = free1;
+    free2.jLinA = Vec3(0, 0, 1);
+    free2.jAngA = Vec3(0, 1, 0);
+    free2.lo = -1;
+    free2.hi = 1;
+    rows.push_back(free2);
+    for (int i = 0; i < 4; ++i) {
+      rows[size_t(m0 + 3 + i)].lambda = varied ? 2.5 + 0.1 * i : 2.5;
+      if (varied) rows[size_t(m1 + 3 + i)].lambda = 1.0 + 0.2 * i;
+    }
+    rows[size_t(m0)].lambda = 0.3;
+  }
+};
+
 TEST_SUITE("compact sweeps") {
 
 TEST_CASE("compact manifold sweeps give the ConstraintRow sweeps' impulses and velocities") {
-  // Two unit boxes (mass 2) stacked on the static ground (body 2), the upper one tipping (w_x = 3 rad/s: its
-  // block update leaves a corner's bound, so the clamped ConstraintRow path runs inside the compact sweep), a
-  // free row on the upper box before the manifolds and one after (rows of other forms are swept in place).
-  std::vector<SolverBodyState> bodies(3);
-  for (int i = 0; i < 2; ++i) {
-    bodies[size_t(i)].invMass = 0.5;
-    bodies[size_t(i)].invInertia = Mat3::Identity() * 3.0;
-  }
-  bodies[0].v = Vec3(0.2, -0.1, -0.5);
-  bodies[0].w = Vec3(0.05, 0, 0.1);
-  bodies[1].v = Vec3(0, 0.1, -0.2);
-  bodies[1].w = Vec3(3.0, 0.2, 0);
-  const Vec3 c0(0, 0, 0.5), c1(0.1, 0, 1.5);
-  std::vector<ConstraintRow> rows;
-  ConstraintRow free1;
-  free1.bodyA = 1;
-  free1.jLinA = Vec3(0.3, 1, 0).normalized();
-  free1.rhs = 0.05;
-  free1.e = 1e-4;
-  rows.push_back(free1);
-  const int m0 = addManifold(rows, 0, -1, c0, Vec3::Zero(), Vec3(0, 0, 0), 0.5, 0.6);
-  const int m1 = addManifold(rows, 1, 0, c1, c0, Vec3(0.05, 0, 1.0), 0.45, 0.4);
-  ConstraintRow free2 = free1;
-  free2.jLinA = Vec3(0, 0, 1);
-  free2.jAngA = Vec3(0, 1, 0);
-  free2.lo = -1;
-  free2.hi = 1;
-  rows.push_back(free2);
-  // Warm start on the lower manifold's normals and friction.
-  for (int i = 0; i < 4; ++i) rows[size_t(m0 + 3 + i)].lambda = 2.5;
-  rows[size_t(m0)].lambda = 0.3;
+  // TippingStack: the tipping box's block update leaves a corner's bound, so the clamped ConstraintRow path runs
+  // inside the compact sweep; the free rows before and after the manifolds are swept in place.
+  const TippingStack scene(false);
+  const std::vector<ConstraintRow>& rows = scene.rows;
+  const std::vector<SolverBodyState>& bodies = scene.bodies;
+  const int m0 = scene.m0, m1 = scene.m1;
 
   std::vector<ConstraintRow> rowsC = rows, rowsR = rows;
   std::vector<SolverBodyState> bodiesC = bodies, bodiesR = bodies;
@@ -240,46 +255,6 @@ TEST_CASE("partitioned sweeps on their own body layout give the serial sweeps' b
   CHECK(R == 2);
 }
 
-// The scene of the first test case: two boxes stacked on the ground, the upper one tipping (its block update
-// leaves a corner's bound), warm-started, with a free row before and after the manifolds.
-struct TippingStack {
-  std::vector<SolverBodyState> bodies = std::vector<SolverBodyState>(3);
-  std::vector<ConstraintRow> rows;
-  int m0 = 0, m1 = 0;
-  TippingStack() {
-    for (int i = 0; i < 2; ++i) {
-      bodies[size_t(i)].invMass = 0.5;
-      bodies[size_t(i)].invInertia = Vec3(3.0, 2.0, 2.5).asDiagonal();
-    }
-    bodies[0].v = Vec3(0.2, -0.1, -0.5);
-    bodies[0].w = Vec3(0.05, 0, 0.1);
-    bodies[1].v = Vec3(0, 0.1, -0.2);
-    bodies[1].w = Vec3(3.0, 0.2, 0);
-    const Vec3 c0(0, 0, 0.5), c1(0.1, 0, 1.5);
-    ConstraintRow free1;
-    free1.bodyA = 1;
-    free1.jLinA = Vec3(0.3, 1, 0).normalized();
-    free1.rhs = 0.05;
-    free1.e = 1e-4;
-    rows.push_back(free1);
-    m0 = addManifold(rows, 0, -1, c0, Vec3::Zero(), Vec3(0, 0, 0), 0.5, 0.6);
-    m1 = addManifold(rows, 1, 0, c1, c0, Vec3(0.05, 0, 1.0), 0.45, 0.4);
-    ConstraintRow free2 = free1;
-    free2.jLinA = Vec3(0, 0, 1);
-    free2.jAngA = Vec3(0, 1, 0);
-    free2.lo = -1;
-    free2.hi = 1;
-    rows.push_back(free2);
-    // Warm start on both manifolds' normals (unequal, so that the per-body sum differs from one row's impulse
-    // times four) and on the lower one's friction.
-    for (int i = 0; i < 4; ++i) {
-      rows[size_t(m0 + 3 + i)].lambda = 2.5 + 0.1 * i;
-      rows[size_t(m1 + 3 + i)].lambda = 1.0 + 0.2 * i;
-    }
-    rows[size_t(m0)].lambda = 0.3;
-  }
-};
-
 // Largest |lambda| of the rows and the largest difference between two runs' impulses and velocities.
 void compareRuns(const std::vector<ConstraintRow>& rowsD, const std::vector<ConstraintRow>& rowsP,
                  const std::vector<SolverBodyState>& bodiesD, const std::vector<SolverBodyState>& bodiesP) {
@@ -301,7 +276,7 @@ void compareRuns(const std::vector<ConstraintRow>& rowsD, const std::vector<Cons
 TEST_CASE("normal rows prepared on first use give the prepared rows' sweeps, fallbacks and shock pass") {
   // PgsSolver::prepare with deferBlockRows leaves the normal blocks' rows without M^-1 J^T (pgs.cpp, "deferred
   // block rows"): the warm start is applied per body, and the paths that read the rows prepare them first.
-  const TippingStack scene;
+  const TippingStack scene(true);
   const PgsSolver::ShockRange m0{uint32_t(scene.m0), 7, 1}, m1{uint32_t(scene.m1), 7, 1};
 
   SUBCASE("the sweeps, with the tipping box's bound-hit fallback") {
