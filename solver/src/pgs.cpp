@@ -495,7 +495,7 @@ static void ensureBlockRows(std::vector<ConstraintRow>& rows, const std::vector<
 // Every deferred block of rows [begin, end) (block rows are contiguous and begin at their first row).
 static void ensureBlockRows(std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
                             size_t begin, size_t end, const PgsBlocks* blocks) {
-  if (!blocks) return;
+  if (!blocks || !blocks->anyDeferred) return;
   for (size_t i = begin; i < end; ++i)
     if (rows[i].blockCount > 1 && rows[i].blockBegin == int32_t(i)) ensureBlockRows(rows, bodies, i, blocks);
 }
@@ -512,7 +512,10 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   // sweeps). With deferBlockRows they are left to those paths (ensureBlockRows), and the block's warm start is
   // applied per body: M^-1 (sum_i lambda_i J_i^T), the same impulse as the rows' one by one in another order
   // of summation (last bits).
-  if (blocks) blocks->starts.clear();
+  if (blocks) {
+    blocks->starts.clear();
+    blocks->anyDeferred = false;
+  }
   for (size_t i = 0; i < rows.size(); ++i) {
     ConstraintRow& r = rows[i];
     SCREE_VALIDATE_CHECK(r.jLinA.allFinite() && r.jAngA.allFinite() && r.jLinB.allFinite() && r.jAngB.allFinite());
@@ -525,6 +528,7 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
       for (size_t k = i + 1; defer && k < i + n; ++k)
         defer = rows[k].bodyA == r.bodyA && rows[k].bodyB == r.bodyB && rows[k].blockBegin == int32_t(i);
       blocks->blocks[slot].rowsReady = !defer;
+      blocks->anyDeferred = blocks->anyDeferred || defer;
       if (defer) {
         SCREE_ASSERT(r.bodyA < int32_t(bodies.size()) && r.bodyB < int32_t(bodies.size()));
         Vec3 lA = Vec3::Zero(), aA = Vec3::Zero(), lB = Vec3::Zero(), aB = Vec3::Zero();

@@ -55,6 +55,9 @@ struct PgsBlocks {
   };
   std::vector<Block> blocks;
   std::vector<uint32_t> starts;  ///< PgsSolver::prepare: each block's first row, in row order (slot order)
+  /// Whether PgsSolver::prepare left any block's rows unprepared (Block::rowsReady): the passes that prepare
+  /// every deferred block of a range return at once when none is.
+  bool anyDeferred = false;
 
   // ---- issue 18 (compact contact arrays; pgs.cpp "Compact manifold sweeps", docs/solver-internals.md) ----
   /// A manifold contact (contact_rows.h: [t1, t2, twist][normal block]) swept as one unit: every datum a visit
