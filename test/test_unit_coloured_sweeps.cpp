@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <cstring>
 #include <set>
@@ -15,6 +16,7 @@
 #include "scenes/scenes.h"
 #include "scree/core/parallel.h"
 #include "scree/solver/pgs.h"
+#include "sweep_threads.h"  // solver/src
 
 using namespace scree;
 using namespace scree::detail;
@@ -158,10 +160,13 @@ TEST_CASE("partition: regions share no dynamic body, the boundary touches both, 
 namespace {
 /// pyramid20's state (positions, velocities, angular velocities, the top's rotation) after `steps` steps (0: the
 /// scene's 600) with partitioned sweeps on `threads` threads.
+// Adaptive thread count off: the 2-thread run must really run on two threads (with it on, the count would follow
+// the host's timing; the bits would not change, but the comparison would test less).
 std::pair<std::vector<Real>, scenes::PyramidMetrics> runPartitioned(int threads, bool shock, int steps) {
   setNumThreads(threads);
   scenes::PyramidScene s = scenes::buildPyramid20();
   s.sim->getSolver().setUsePartitionedSweeps(true);
+  s.sim->getSolver().setUseAdaptiveSweepThreads(false);
   s.sim->getSolver().setUseShockPropagation(shock);
   for (int i = 0; i < (steps > 0 ? steps : s.numSteps); ++i) s.step();
   setNumThreads(1);
@@ -194,6 +199,124 @@ TEST_CASE("partitioned sweeps: pyramid20 is bit-identical on 1 and 2 threads, wi
       CHECK(m1.maxDisplacement < 0.01);
     }
   }
+}
+
+// ---- issue 18: the partitioned sweeps' thread count by measurement (solver/src/sweep_threads.h) ----
+TEST_CASE("sweep thread choice: probe schedule, the faster count wins, ties go to one thread, holds double") {
+  using C = SweepThreadChoice;
+  constexpr int P = C::kProbeSteps;
+  // One probe with times t2 per step on two threads and t1 on one; every step's count is checked against the
+  // schedule (P steps on 2, P on 1). The settling steps get an outlier that must not count.
+  // Steps' times spread by `spread` (s) per step, upwards on two threads and downwards on one.
+  auto probe = [](C& c, double t2, double t1, double spread = 1e-6) {
+    for (int k = 0; k < P; ++k) {
+      REQUIRE(c.begin(2) == 2);
+      REQUIRE(c.probing());
+      c.end(k < C::kSettleSteps ? 1.0 : t2 + spread * k);
+    }
+    for (int k = 0; k < P; ++k) {
+      REQUIRE(c.begin(2) == 1);
+      c.end(k < C::kSettleSteps ? 1.0 : t1 - spread * k);
+    }
+  };
+  auto holdFor = [](C& c, int steps, int count) {
+    for (int k = 0; k < steps; ++k) {
+      REQUIRE(c.begin(2) == count);
+      REQUIRE_FALSE(c.probing());
+      c.end(1.0);  // times during a hold do not matter
+    }
+  };
+  SUBCASE("two threads faster: kept, and each confirming probe doubles the hold up to its cap") {
+    C c;
+    CHECK(c.chosen() == 0);
+    probe(c, 0.4e-3, 0.6e-3);
+    CHECK(c.chosen() == 2);
+    CHECK(c.hold() == C::kFirstHold);
+    // Medians of the timed steps only (the settling steps' 1 s is left out): steps 2..7, the mean of steps 4
+    // and 5.
+    CHECK(std::abs(c.medianMany() - (0.4e-3 + 4.5e-6)) < 1e-15);
+    CHECK(std::abs(c.medianOne() - (0.6e-3 - 4.5e-6)) < 1e-15);
+    int hold = C::kFirstHold;
+    for (int round = 0; round < 8; ++round) {
+      holdFor(c, hold, 2);
+      probe(c, 0.4e-3, 0.6e-3);
+      hold = std::min(2 * hold, C::kMaxHold);
+      CHECK(c.hold() == hold);
+    }
+    CHECK(c.hold() == C::kMaxHold);
+  }
+  SUBCASE("one thread faster: chosen; a later probe that finds two faster switches back and resets the hold") {
+    C c;
+    probe(c, 0.65e-3, 0.43e-3);
+    CHECK(c.chosen() == 1);
+    holdFor(c, C::kFirstHold, 1);
+    probe(c, 0.65e-3, 0.43e-3);
+    CHECK(c.hold() == 2 * C::kFirstHold);
+    holdFor(c, 2 * C::kFirstHold, 1);
+    probe(c, 0.30e-3, 0.43e-3);  // the host got faster between the cores
+    CHECK(c.chosen() == 2);
+    CHECK(c.hold() == C::kFirstHold);
+    holdFor(c, C::kFirstHold, 2);
+  }
+  SUBCASE("a tie goes to one thread") {
+    C c;
+    probe(c, 0.5e-3, 0.5e-3, 0.0);
+    CHECK(c.medianOne() == c.medianMany());
+    CHECK(c.chosen() == 1);
+  }
+  SUBCASE("one available thread: no probe, always one; a change of the available count starts a new probe") {
+    C c;
+    for (int k = 0; k < 50; ++k) {
+      CHECK(c.begin(1) == 1);
+      CHECK_FALSE(c.probing());
+      c.end(1.0);
+    }
+    probe(c, 0.4e-3, 0.6e-3);
+    CHECK(c.chosen() == 2);
+    CHECK(c.begin(1) == 1);
+    c.end(1.0);
+    CHECK(c.begin(2) == 2);  // back to two: probing from the start
+    CHECK(c.probing());
+  }
+}
+
+TEST_CASE("partitioned sweeps with the adaptive thread count: the probe schedule, and the bits of one thread") {
+  // pyramid20 on two threads with Solver::setUseAdaptiveSweepThreads (the default): the first kProbeSteps steps
+  // run on two threads and the next kProbeSteps on one, then the faster count (host-dependent) for the hold.
+  // Whatever the counts, the state after 40 steps must be the one-thread run's, bit for bit.
+  setNumThreads(2);
+  const bool twoThreads = getNumThreads() == 2;
+  setNumThreads(1);
+  if (!twoThreads) {
+    WARN_MESSAGE(false, "built without OpenMP: no second thread to choose");
+    return;
+  }
+  constexpr int steps = 40, P = SweepThreadChoice::kProbeSteps;
+  const auto [one, m1] = runPartitioned(1, true, steps);
+  setNumThreads(2);
+  scenes::PyramidScene s = scenes::buildPyramid20();
+  REQUIRE(s.sim->getSolver().getUseAdaptiveSweepThreads());
+  s.sim->getSolver().setUsePartitionedSweeps(true);
+  std::vector<int> counts;
+  for (int i = 0; i < steps; ++i) {
+    s.step();
+    counts.push_back(s.sim->getSolver().getStats().numSweepThreads);
+  }
+  setNumThreads(1);
+  for (int i = 0; i < steps; ++i) {
+    CAPTURE(i);
+    if (i < P) CHECK(counts[size_t(i)] == 2);
+    else if (i < 2 * P) CHECK(counts[size_t(i)] == 1);
+    else CHECK(counts[size_t(i)] == counts[size_t(2 * P)]);  // the hold (120 steps) outlasts the run
+  }
+  MESSAGE("pyramid20 partitioned, adaptive: chose " << counts.back() << " thread(s) on this host");
+  const std::vector<Real> two = pyramidState(s);
+  REQUIRE(one.size() == two.size());
+  CHECK(std::memcmp(one.data(), two.data(), one.size() * sizeof(Real)) == 0);
+  // The default serial path reports one thread.
+  scenes::PyramidScene d = scenes::buildPyramid20();
+  d.step();
+  CHECK(d.sim->getSolver().getStats().numSweepThreads == 1);
 }
 
 // ---- issue 18 (sweep scheduling): the persistent team the partitioned stages run on (scree/core/parallel.h) ----

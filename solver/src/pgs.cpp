@@ -1637,8 +1637,12 @@ Real sweepUnits(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& 
   return m;
 }
 
-/// Threads for a partitioned stage: at most one per region; 1 for small work (the result is the same either way).
-int partitionThreads(bool worthIt) { return worthIt ? std::min(PgsPartition::kRegions, scree::getNumThreads()) : 1; }
+/// Threads for a partitioned stage: at most one per region and PgsPartition::maxThreads; 1 for small work (the
+/// result is the same either way).
+int partitionThreads(bool worthIt, const PgsPartition& p) {
+  const int cap = p.maxThreads > 0 ? p.maxThreads : scree::getNumThreads();
+  return worthIt ? std::max(1, std::min(PgsPartition::kRegions, cap)) : 1;
+}
 }  // namespace
 
 Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
@@ -1720,7 +1724,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   const PgsPartition::Unit* order = p.order.data();
   const int32_t* manifold = p.unitManifold.data();
   const bool boundary = split[R + 1] > split[R];
-  const int threads = partitionThreads(nu >= 64);
+  const int threads = partitionThreads(nu >= 64, p);
   Real lastSweep[R] = {};
   TeamBarrier barrier(threads);
   runTeam(threads, [&](int t, int nt) {
@@ -1781,7 +1785,7 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
                           const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks,
                           PgsPartition& p) {
   constexpr int R = PgsPartition::kRegions;
-  const int threads = partitionThreads(ranges.size() >= 16);
+  const int threads = partitionThreads(ranges.size() >= 16, p);
   if (threads < 2) {
     shockPass(rows, bodies, ranges, maxSweeps, blocks);
     return;

@@ -14,6 +14,7 @@
 #include "contact_rows.h"
 #include "friction_anchor.h"  // issue 18 (friction anchors)
 #include "granular_stage.h"
+#include "sweep_threads.h"
 #include "scree/collide/particle_collider.h"
 #include "scree/collide/space.h"
 #include "scree/solver/direct.h"
@@ -95,6 +96,7 @@ struct SimulationState {
   // ---- issue 18 (sweep scheduling): partitioned sweeps (Solver::setUsePartitionedSweeps), storage reused ----
   PgsPartition partition;
   bool partitionReady = false;  // the partition was computed for this step's rows (iterative paths only)
+  SweepThreadChoice sweepThreads;  // the partitioned work's thread count by measurement (sweep_threads.h)
   // Warm-start source (issue 18, solve_stage.cpp rigidShock): per contact row in the rigid shock pass, the
   // sweeps' impulse (plus, for a single support's normal rows, an even share of the load the pass added); NaN for
   // other rows; empty when no shock pass ran. storeResults caches these instead of the solved impulses.

@@ -20,9 +20,11 @@
 // operators are built once per step into reused storage (pgs.cpp). The direct-set subset sweeps of the HYBRID
 // path do not use them (they solve row by row, as before).
 #include <algorithm>
+#include <chrono>
 #include <limits>
 
 #include "scree/core/logger.h"
+#include "scree/core/parallel.h"
 #include "step_stages.h"
 
 namespace scree::detail {
@@ -265,6 +267,15 @@ void iterativePath(SimulationState& s, bool interleaved) {
     PgsSolver::colour(s.rows, s.sb, s.colouring);
   }
   SolverStats& st = s.solverStats();
+  // The partitioned work's thread count (sweep_threads.h): every available thread, or by measurement.
+  using Clock = std::chrono::steady_clock;
+  const bool timed = s.partitionReady && s.solver.getUseAdaptiveSweepThreads();
+  if (s.partitionReady) {
+    const int available = std::min(PgsPartition::kRegions, scree::getNumThreads());
+    s.partition.maxThreads = timed ? s.sweepThreads.begin(available) : available;
+    st.numSweepThreads = s.partition.maxThreads;
+  }
+  const Clock::time_point start = timed ? Clock::now() : Clock::time_point{};
   const int iterations = s.solver.getNumIterations();
   const bool particles = hasParticleUnits(s);
   st.numIterativeRows = s.rows.size();
@@ -284,6 +295,7 @@ void iterativePath(SimulationState& s, bool interleaved) {
   st.lastResidual = residual;
   st.numIterations = size_t(iterations);
   if (!s.rows.empty()) rigidShock(s, false);
+  if (timed) s.sweepThreads.end(std::chrono::duration<double>(Clock::now() - start).count());
 }
 
 }  // namespace
@@ -294,6 +306,7 @@ void solve(SimulationState& s) {
   st.complementarityResidual = 0;
   st.factorisationTime = 0;
   st.directFallback = false;
+  st.numSweepThreads = 1;
   s.directSet.clear();
   s.iterSet.clear();
   s.sweepLambda.clear();

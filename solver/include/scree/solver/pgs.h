@@ -188,6 +188,9 @@ struct PgsPartition {
   std::vector<uint32_t> shockList[kRegions];
   std::vector<uint32_t> shockWait[kRegions];
   std::vector<uint32_t> shockDone;  ///< per solver body: 1 + position of its last writer in its region's list
+  /// Cap on the threads of the partitioned sweeps and shock pass (0: scree::getNumThreads()); at most one thread
+  /// per region either way. The solve stage sets it from its measurements (Solver::setUseAdaptiveSweepThreads).
+  int maxThreads = 0;
 };
 
 class PgsSolver {

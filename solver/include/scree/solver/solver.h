@@ -37,6 +37,9 @@ struct SolverStats {
   size_t numProjectionIterations = 0;  ///< Newton iterations (one factorisation each) this step
   Real projectionDrift = 0;     ///< largest |drift| of a projected row before the projection, m or rad
   Real projectionResidual = 0;  ///< largest drift beyond the tolerance after it (0 when no iteration ran)
+  /// Threads the partitioned sweeps and shock pass ran on this step (Solver::setUsePartitionedSweeps,
+  /// setUseAdaptiveSweepThreads); 1 on every other path.
+  int numSweepThreads = 1;
 };
 
 class Solver {
@@ -157,6 +160,16 @@ class Solver {
   /// default's. Takes precedence over setUseColouredSweeps when both are on.
   void setUsePartitionedSweeps(bool on) { partitionedSweeps_ = on; }
   bool getUsePartitionedSweeps() const { return partitionedSweeps_; }
+  /// The partitioned sweeps' thread count by measurement (default on): whether a second thread pays depends on
+  /// the host (how fast a cache line crosses between its cores) more than on the scene, and the results are the
+  /// same bits on any count. So the solve stage times its partitioned sweeps and shock pass on every available
+  /// thread (scree::setNumThreads, at most one per region) and on one, 8 steps each (the first 2 not counted),
+  /// and keeps the count with the lower median (one on a tie) for 120 steps, then measures again; each
+  /// measurement that confirms the choice doubles the hold, up to 7680 steps. Off: always every available
+  /// thread. SolverStats::numSweepThreads reports the count of the last step. docs/solver-internals.md
+  /// "Partitioned sweeps: the thread count by measurement".
+  void setUseAdaptiveSweepThreads(bool on) { adaptiveSweepThreads_ = on; }
+  bool getUseAdaptiveSweepThreads() const { return adaptiveSweepThreads_; }
   const SolverStats& getStats() const { return stats_; }
 
  private:
@@ -180,6 +193,7 @@ class Solver {
   bool colouredSweeps_ = false;  // issue 18 (sweep scheduling)
   bool frictionAnchors_ = false;  // issue 18 (friction anchors), opt-in
   bool partitionedSweeps_ = false;  // issue 18 (sweep scheduling): partitioned sweeps
+  bool adaptiveSweepThreads_ = true;  // issue 18: the partitioned sweeps' thread count by measurement
 };
 
 }  // namespace scree
