@@ -153,6 +153,21 @@ void BM_pyramid20_partitioned_stages(benchmark::State& state) {
 BENCHMARK(BM_pyramid20_partitioned_stages)->Arg(1)->Arg(2)->Iterations(1)->Repetitions(3)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// The same with the thread count fixed (Solver::setUseAdaptiveSweepThreads(false)): what two threads cost on this
+// host, which the default (by measurement, solver/src/sweep_threads.h) avoids when it is more than one thread's.
+void BM_pyramid20_partitioned_fixed_stages(benchmark::State& state) {
+  runStages<PyramidScene>(state,
+                          [] {
+                            PyramidScene s = buildPyramid20();
+                            s.sim->getSolver().setUsePartitionedSweeps(true);
+                            s.sim->getSolver().setUseAdaptiveSweepThreads(false);
+                            return s;
+                          },
+                          [](const PyramidScene& s) { return measurePyramid(s).maxDisplacement; });
+}
+BENCHMARK(BM_pyramid20_partitioned_fixed_stages)->Arg(2)->Iterations(1)->Repetitions(3)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_tower10_stages(benchmark::State& state) {
   runStages<TowerScene>(state, [] { return buildTower10(); },
                         [](const TowerScene& s) { return measureTower(s).topHorizontal; });
