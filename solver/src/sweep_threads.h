@@ -7,7 +7,7 @@
 // count is free to change from step to step. Whether a second thread pays depends on the host more than on the
 // scene: on the 2-core KVM guest this was written on, a cache line took either about 150 ns or about 550 ns to
 // cross between the cores, in states that lasted hours; in the slow state pyramid20's partitioned solve took
-// 0.65 ms per step on two threads against 0.43 ms on one, in the fast state about 1.1x less on two. A user who
+// 0.65 ms per step on two threads against 0.43 ms on one; in the fast state two threads took about 1.1x less. A user who
 // asks for two threads should never get a slower simulation for it. So the solve stage times the
 // thread-dependent part of its step (the partitioned sweeps and shock pass) and this class picks the count:
 //  - probe: kProbeSteps steps on every available thread (at most one per region), then kProbeSteps on one; the
