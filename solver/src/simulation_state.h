@@ -12,6 +12,7 @@
 
 #include "body_access.h"
 #include "contact_rows.h"
+#include "coarse_correction.h"  // issue 18 (coarse correction)
 #include "friction_anchor.h"  // issue 18 (friction anchors)
 #include "granular_stage.h"
 #include "sweep_threads.h"
@@ -105,6 +106,8 @@ struct SimulationState {
   // Issue 18 (solver sweep): the manifold normal blocks' operators, built by PgsSolver::prepare each step into
   // storage kept across steps (pgs.h PgsBlocks).
   PgsBlocks pgsBlocks;
+  // ---- issue 18 (coarse correction, coarse_correction.h): its storage and kept symbolic analysis ----
+  CoarseCorrection coarse;
   // ---- issue 18 (friction anchors, friction_anchor.h): manifold anchors kept across steps and this step's
   // anchored manifolds (Solver::setUseFrictionAnchors) ----
   FrictionAnchorCache frictionAnchors;
