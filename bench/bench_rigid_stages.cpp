@@ -197,6 +197,21 @@ void BM_pyramid20_noshock_stages(benchmark::State& state) {
 }
 BENCHMARK(BM_pyramid20_noshock_stages)->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+// ---- issue 18 (coarse correction, Solver::setUseCoarseCorrection; docs/solver-internals.md "Coarse
+// correction"): pyramid20 without the shock pass, anchors on, with the correction after the 2nd and 4th sweep.
+// Compare with BM_pyramid20_anchor_stages/0 (the same without it) and BM_pyramid20_stages/1 (the default).
+void BM_pyramid20_coarse_stages(benchmark::State& state) {
+  runStagesOneThread<PyramidScene>(
+      state,
+      [] {
+        PyramidScene s = buildPyramid20With(true, false);
+        s.sim->getSolver().setUseCoarseCorrection(true);
+        return s;
+      },
+      [](const PyramidScene& s) { return measurePyramid(s).maxDisplacement; });
+}
+BENCHMARK(BM_pyramid20_coarse_stages)->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // ---- issue 18 (sweep scheduling): the persistent team's costs (scree/core/parallel.h; docs/solver-internals.md
 // "Persistent team"). Arg = threads. BM_team_fork_join: one runTeam with an empty job (what a partitioned stage
