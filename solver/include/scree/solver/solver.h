@@ -188,7 +188,7 @@ class Solver {
   /// them the sticking friction creeps, its loads build up to the cone and pyramid20 falls after a few seconds.
   /// Measured up to 25 rows; on pyramid30 the correction cannot keep within the bounds and is skipped, so that
   /// scene runs (and collapses) as on the plain sweeps, where the shock pass holds it.
-  /// Cost on pyramid20 (about 1600 unknowns, two factorisations per step): 4.3 ms per step against 0.59 ms for
+  /// Cost on pyramid20 (about 1600 unknowns, two factorisations per step): 4.6 ms per step against 0.61 ms for
   /// the default (bench_rigid_stages, BM_pyramid20_coarse_stages; docs/solver-internals.md "Coarse correction").
   void setUseCoarseCorrection(bool on) { coarseCorrection_ = on; }
   bool getUseCoarseCorrection() const { return coarseCorrection_; }
