@@ -382,8 +382,9 @@ TEST_CASE("persistent team: a lost wake-up costs at most the sleep bound, not a 
   // bench_rigid_stages BM_team_barrier hung in 3 of 13 runs in a KVM guest: a thread asleep on the barrier's
   // phase was never woken after the phase changed (core/src/parallel.cpp, sleepWhile). Every sleep is now bounded
   // (1 ms inside a step). The test makes the lost wake-up certain: the value is stored with no wake at all, after
-  // the waiter has spun out and gone to sleep (50 ms later; its spin is 4000 loads and 4 yields). Without the bound
-  // the waiter sleeps for ever and ctest's timeout fails the test; with it, the waiter returns after the store.
+  // the waiter has spun out and gone to sleep (50 ms later; its spin is teamSpinTime() = 50 us and 4 yields).
+  // Without the bound the waiter sleeps for ever and ctest's timeout fails the test; with it, the waiter returns
+  // after the store.
   // (The wait's length is not asserted: timing on a shared machine is the bench's business.)
   std::atomic<uint32_t> value{0};
   std::atomic<bool> returned{false};

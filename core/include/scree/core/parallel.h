@@ -34,8 +34,8 @@ namespace scree::detail {
 /// one. Between jobs a worker spins for up to 2 ms, yielding every 256 loads (waking a sleeping worker through the
 /// futex cost about 0.2 ms in the KVM guest this was measured on, more than half the parallel work of a small
 /// scene's step), then sleeps on a futex for at most 20 ms at a time (see publish); the caller, the barrier and
-/// waitAtLeast spin `teamSpinCount()` loads, yield 4 times, then sleep for at most 1 ms at a time. A fork-join to
-/// a spinning worker costs about 1 us (bench_rigid_stages BM_team_fork_join).
+/// waitAtLeast spin for `teamSpinTime()` microseconds, yield 4 times, then sleep for at most 1 ms at a time. A
+/// fork-join to a spinning worker costs about 0.5 us (bench_rigid_stages BM_team_fork_join).
 /// Called from inside a job, or while another thread of the program uses the team, the job runs once on the
 /// calling thread as job(ctx, 0, 1): a job must split its work by (t, n) and give the same result for any n (the
 /// partitioned sweeps do), and must not wait for a partner when n is 1.
@@ -48,11 +48,12 @@ void runTeam(int n, F&& f) {
   runTeamJob(n, [](void* c, int t, int nt) { (*static_cast<Fn*>(c))(t, nt); }, const_cast<void*>(static_cast<const void*>(&f)));
 }
 
-/// Loads a waiting thread spins before it sleeps (team, TeamBarrier, waitAtLeast).
-constexpr int teamSpinCount() { return 4000; }
+/// Microseconds a waiting thread spins before it yields and sleeps (TeamBarrier, waitAtLeast; core/src/parallel.cpp,
+/// spinWhile, says why a time and not a count of loads).
+constexpr int teamSpinTime() { return 50; }
 
-/// Waits until `a` holds at least `target`: spins teamSpinCount() loads, yields 4 times, then sleeps on the atomic
-/// for at most 1 ms at a time (see publish).
+/// Waits until `a` holds at least `target`: spins for teamSpinTime() microseconds, yields 4 times, then sleeps on the
+/// atomic for at most 1 ms at a time (see publish).
 void waitAtLeast(const std::atomic<uint32_t>& a, uint32_t target);
 
 /// Stores `value` into `a` and wakes every thread sleeping on `a` (waitAtLeast, TeamBarrier, the team). Every
