@@ -108,6 +108,7 @@ TEST_CASE("coarse correction: one correction after 2 sweeps gives a 20-box stack
           "correction " << contactLoad(coarse, 0) / bottom << " (" << r.unknowns << " unknowns, alpha " << r.alpha
           << ")");
   CHECK(r.unknowns == 3 * n);  // load and two tilts per square manifold, no friction rows
+  CHECK(r.analysed);           // the first correction analyses the coarse operator's pattern
   CHECK(r.alpha == doctest::Approx(1.0));
   CHECK(contactLoad(plain, 0) < 0.9 * bottom);  // what the correction is for: 10 sweeps leave > 10 % missing
   for (int k = 0; k < n; ++k)
@@ -120,7 +121,9 @@ TEST_CASE("coarse correction: one correction after 2 sweeps gives a 20-box stack
   // A second correction after two more sweeps shrinks what the regularisation left, by at least 10x (rho alone
   // would give rho^2; the sweeps between move the error between modes: measured 8e-5 of the bottom load).
   PgsSolver::iterate(coarse.rows, coarse.bodies, 2);
-  cc.apply(coarse.rows, coarse.bodies, coarse.couplings);
+  const CoarseCorrection::Result again = cc.apply(coarse.rows, coarse.bodies, coarse.couplings);
+  CHECK(again.unknowns == r.unknowns);
+  CHECK_FALSE(again.analysed);  // same manifolds, same unknowns: the kept symbolic analysis is reused
   for (int k = 0; k < n; ++k)
     CHECK(std::abs(contactLoad(coarse, k) - (n - k) * kMass * kG * kH) < 0.1 * rho * bottom);
 }

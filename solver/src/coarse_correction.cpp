@@ -13,18 +13,13 @@
 namespace scree::detail {
 namespace {
 
-Real rowVelocity(const ConstraintRow& q, const std::vector<SolverBodyState>& sb) {
-  Real x = 0;
-  if (q.bodyA >= 0) x += q.jLinA.dot(sb[size_t(q.bodyA)].v) + q.jAngA.dot(sb[size_t(q.bodyA)].w);
-  if (q.bodyB >= 0) x += q.jLinB.dot(sb[size_t(q.bodyB)].v) + q.jAngB.dot(sb[size_t(q.bodyB)].w);
-  return x;
-}
-
 /// What is left of row q's equation J v + e lambda = rhs.
 Real rowResidual(const ConstraintRow& q, const std::vector<SolverBodyState>& sb) {
   return q.rhs - rowVelocity(q, sb) - q.e * q.lambda;
 }
 
+/// Applies impulse d along row q through the bodies' masses and inertias (not the row's M^-1 J^T, which
+/// PgsSolver::prepare leaves unset on deferred block rows: pgs.cpp's applyImpulse cannot serve here).
 void applyImpulse(const ConstraintRow& q, Real d, std::vector<SolverBodyState>& sb) {
   if (d == 0) return;
   if (q.bodyA >= 0) {

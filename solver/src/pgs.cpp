@@ -51,13 +51,6 @@ constexpr int kMaxNormalBlock = 16;
 /// (1e-5: 5.9 sweeps, 0.030 cm; 1e-4: 0.66 cm). docs/solver-internals.md, "Sweep cost".
 constexpr Real kShockTolerance = 1e-7;  ///< most normal rows one block holds (contact_rows.cpp builds no larger)
 
-inline Real rowVelocity(const ConstraintRow& r, const std::vector<SolverBodyState>& b) {
-  Real jv = 0;
-  if (r.bodyA >= 0) jv += r.jLinA.dot(b[r.bodyA].v) + r.jAngA.dot(b[r.bodyA].w);
-  if (r.bodyB >= 0) jv += r.jLinB.dot(b[r.bodyB].v) + r.jAngB.dot(b[r.bodyB].w);
-  return jv;
-}
-
 inline void applyImpulse(const ConstraintRow& r, Real d, std::vector<SolverBodyState>& b) {
   if (r.bodyA >= 0) {
     b[r.bodyA].v += r.mJLinA * d;

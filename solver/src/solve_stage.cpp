@@ -266,6 +266,7 @@ Real rigidSweepsCoarse(SimulationState& s, int iterations) {
     const CoarseCorrection::Result r = s.coarse.apply(s.rows, s.sb, s.couplings);
     st.numCoarseUnknowns = std::max(st.numCoarseUnknowns, size_t(r.unknowns));
     st.numCoarseRefinements += size_t(r.refinements);
+    st.numCoarseAnalyses += r.analysed ? 1 : 0;
   }
   if (iterations > done) residual = rigidSweeps(s, iterations - done);
   return residual;
@@ -329,7 +330,7 @@ void solve(SimulationState& s) {
   st.factorisationTime = 0;
   st.directFallback = false;
   st.numSweepThreads = 1;
-  st.numCoarseUnknowns = st.numCoarseRefinements = 0;
+  st.numCoarseUnknowns = st.numCoarseRefinements = st.numCoarseAnalyses = 0;
   s.directSet.clear();
   s.iterSet.clear();
   s.sweepLambda.clear();

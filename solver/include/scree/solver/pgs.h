@@ -27,6 +27,14 @@ struct SolverBodyState {
   Mat3 invInertia = Mat3::Zero();
 };
 
+/// J v of row r: its velocity along the row's Jacobian (bodies with index < 0 are static and contribute nothing).
+inline Real rowVelocity(const ConstraintRow& r, const std::vector<SolverBodyState>& b) {
+  Real jv = 0;
+  if (r.bodyA >= 0) jv += r.jLinA.dot(b[size_t(r.bodyA)].v) + r.jAngA.dot(b[size_t(r.bodyA)].w);
+  if (r.bodyB >= 0) jv += r.jLinB.dot(b[size_t(r.bodyB)].v) + r.jAngB.dot(b[size_t(r.bodyB)].w);
+  return jv;
+}
+
 /// The constant operators of each manifold normal block (pgs.cpp solveNormalBlock), built once per step by
 /// PgsSolver::prepare so that a sweep's block visit is three 12-wide dot products, a 3 x 3 triangular solve and
 /// three 12-wide updates instead of assembling and factoring the 3 x 3 system on every visit (issue 18: that

@@ -41,9 +41,11 @@ struct SolverStats {
   /// setUseAdaptiveSweepThreads); 1 on every other path.
   int numSweepThreads = 1;
   /// Coarse correction (Solver::setUseCoarseCorrection): the largest number of coarse unknowns of this step's
-  /// corrections, and the re-factorisations for groups held at their bounds; 0 when off.
+  /// corrections, the re-factorisations for groups held at their bounds, and the corrections that needed a fresh
+  /// symbolic analysis of the coarse operator (0 while its sparsity pattern holds); all 0 when off.
   size_t numCoarseUnknowns = 0;
   size_t numCoarseRefinements = 0;
+  size_t numCoarseAnalyses = 0;
 };
 
 class Solver {
