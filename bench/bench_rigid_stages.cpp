@@ -168,6 +168,27 @@ void BM_pyramid20_partitioned_fixed_stages(benchmark::State& state) {
 BENCHMARK(BM_pyramid20_partitioned_fixed_stages)->Arg(2)->Iterations(1)->Repetitions(3)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// How the partitioned step's two-thread gain grows with the scene: pyramids of 20, 30 and 40 rows (210, 465 and
+// 820 boxes), Args = (rows, threads), the thread count fixed. The parallel part (region sweeps, shock pass) grows
+// with the contacts like the serial part (row build, prepare, records, store), so this measures how much of the
+// serial part's cost is per step rather than per contact (docs/solver-internals.md "The team's waits spin by
+// time").
+void BM_pyramid_partitioned_scaling(benchmark::State& state) {
+  const int rows = int(state.range(0));
+  runStages<PyramidScene>(
+      state,
+      [rows] {
+        PyramidScene s = buildPyramid(rows);
+        s.sim->getSolver().setUsePartitionedSweeps(true);
+        s.sim->getSolver().setUseAdaptiveSweepThreads(false);
+        return s;
+      },
+      [](const PyramidScene& s) { return measurePyramid(s).maxDisplacement; }, int(state.range(1)));
+}
+BENCHMARK(BM_pyramid_partitioned_scaling)
+    ->Args({20, 1})->Args({20, 2})->Args({30, 1})->Args({30, 2})->Args({40, 1})->Args({40, 2})
+    ->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_tower10_stages(benchmark::State& state) {
   runStages<TowerScene>(state, [] { return buildTower10(); },
                         [](const TowerScene& s) { return measureTower(s).topHorizontal; });
