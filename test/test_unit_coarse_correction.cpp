@@ -109,6 +109,7 @@ TEST_CASE("coarse correction: one correction after 2 sweeps gives a 20-box stack
           << ")");
   CHECK(r.unknowns == 3 * n);  // load and two tilts per square manifold, no friction rows
   CHECK(r.analysed);           // the first correction analyses the coarse operator's pattern
+  CHECK(r.factorised);         // and factors it
   CHECK(r.alpha == doctest::Approx(1.0));
   CHECK(contactLoad(plain, 0) < 0.9 * bottom);  // what the correction is for: 10 sweeps leave > 10 % missing
   for (int k = 0; k < n; ++k)
@@ -124,6 +125,8 @@ TEST_CASE("coarse correction: one correction after 2 sweeps gives a 20-box stack
   const CoarseCorrection::Result again = cc.apply(coarse.rows, coarse.bodies, coarse.couplings);
   CHECK(again.unknowns == r.unknowns);
   CHECK_FALSE(again.analysed);  // same manifolds, same unknowns: the kept symbolic analysis is reused
+  // Same groups, Jacobians and masses: the same operator bit for bit, so the kept factor serves again.
+  CHECK_FALSE(again.factorised);
   for (int k = 0; k < n; ++k)
     CHECK(std::abs(contactLoad(coarse, k) - (n - k) * kMass * kG * kH) < 0.1 * rho * bottom);
 }

@@ -198,10 +198,22 @@ CoarseCorrection::Result CoarseCorrection::apply(std::vector<ConstraintRow>& row
     analysed_ = true;
     result.analysed = true;
   }
-  ldlt_.factorize(A_);
-  if (ldlt_.info() != Eigen::Success) {
-    analysed_ = false;
-    return result;
+  // The numeric factorisation only when A changed: within a step the Jacobians and masses are fixed, so the
+  // second correction of a step gets the same operator, bit for bit, whenever its groups are the first's (a
+  // resting scene: the same loaded manifolds and the same sticking rows). A refinement leaves the factor of its
+  // held system, so the next call factors again.
+  const bool sameValues = same && factorOfA_ && int(factoredValues_.size()) == A_.nonZeros() &&
+                          std::equal(factoredValues_.begin(), factoredValues_.end(), A_.valuePtr());
+  if (!sameValues) {
+    factorOfA_ = false;
+    ldlt_.factorize(A_);
+    if (ldlt_.info() != Eigen::Success) {
+      analysed_ = false;
+      return result;
+    }
+    factoredValues_.assign(A_.valuePtr(), A_.valuePtr() + A_.nonZeros());
+    factorOfA_ = true;
+    result.factorised = true;
   }
   const Eigen::Map<const Eigen::Matrix<Real, Eigen::Dynamic, 1>> r(residual_.data(), m);
   Eigen::Matrix<Real, Eigen::Dynamic, 1> mu = ldlt_.solve(r);
@@ -294,6 +306,7 @@ CoarseCorrection::Result CoarseCorrection::apply(std::vector<ConstraintRow>& row
         held_.coeffRef(g, g) *= 1e8;
         rh[g] = held_.coeff(g, g) * target_[size_t(g)];
       }
+    factorOfA_ = false;
     ldlt_.factorize(held_);
     if (ldlt_.info() != Eigen::Success) return result;
     mu = ldlt_.solve(rh);

@@ -61,6 +61,7 @@ class CoarseCorrection {
     int unknowns = 0;        ///< coarse unknowns of this correction
     int refinements = 0;     ///< re-factorisations for held groups
     bool analysed = false;   ///< a fresh symbolic analysis was needed
+    bool factorised = false; ///< A was factored (false: the same A as the factor kept from the last call)
     Real alpha = 0;          ///< descent guard's step (1: the full correction)
     bool skipped = false;    ///< groups still left their bounds after kRounds refinements: nothing applied
   };
@@ -92,6 +93,8 @@ class CoarseCorrection {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<Real>, Eigen::Lower> ldlt_;
   std::vector<int> patternOuter_, patternInner_;
   bool analysed_ = false;
+  bool factorOfA_ = false;             ///< ldlt_ holds the factor of A with factoredValues_ (not a held system)
+  std::vector<Real> factoredValues_;
   // Rows the correction may change, their impulses and residuals before it, the per-row change.
   std::vector<uint32_t> touched_;
   std::vector<int> slot_;
