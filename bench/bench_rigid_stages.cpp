@@ -233,6 +233,22 @@ void BM_pyramid20_coarse_stages(benchmark::State& state) {
 }
 BENCHMARK(BM_pyramid20_coarse_stages)->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+// The same with the partitioned sweeps, Arg = threads (fixed): the correction is serial between the sweep calls,
+// and the 1- and 2-thread fingerprints agree.
+void BM_pyramid20_coarse_partitioned_stages(benchmark::State& state) {
+  runStages<PyramidScene>(
+      state,
+      [] {
+        PyramidScene s = buildPyramid20With(true, false);
+        s.sim->getSolver().setUseCoarseCorrection(true);
+        s.sim->getSolver().setUsePartitionedSweeps(true);
+        s.sim->getSolver().setUseAdaptiveSweepThreads(false);
+        return s;
+      },
+      [](const PyramidScene& s) { return measurePyramid(s).maxDisplacement; });
+}
+BENCHMARK(BM_pyramid20_coarse_partitioned_stages)->Arg(1)->Arg(2)->Iterations(1)->Repetitions(3)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // ---- issue 18 (sweep scheduling): the persistent team's costs (scree/core/parallel.h; docs/solver-internals.md
 // "Persistent team"). Arg = threads. BM_team_fork_join: one runTeam with an empty job (what a partitioned stage
