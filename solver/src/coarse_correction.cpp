@@ -11,6 +11,45 @@
 #include "contact_rows.h"
 
 namespace scree::detail {
+
+// A = the triplets summed (duplicates in triplet order), then each diagonal times 1 + kRegularisation. While the
+// triplets' (row, column) sequence is last call's, their values are added straight into the kept matrix's value
+// array (tripletSlot_): the same sums in the same order as Eigen's setFromTriplets, so the same bits, without its
+// sort, its temporary row-major copy and their allocations (setFromTriplets was about a sixth of the correction's
+// time, docs/solver-internals.md "Coarse correction").
+void CoarseCorrection::assemble(int m) {
+  const size_t nt = triplets_.size();
+  bool same = keptRows_ == m && tripletKey_.size() == nt;
+  for (size_t t = 0; same && t < nt; ++t)
+    same = tripletKey_[t].first == triplets_[t].row() && tripletKey_[t].second == triplets_[t].col();
+  if (!same) {
+    A_.resize(m, m);
+    A_.setFromTriplets(triplets_.begin(), triplets_.end());
+    tripletKey_.resize(nt);
+    tripletSlot_.resize(nt);
+    for (size_t t = 0; t < nt; ++t) {
+      const int r = triplets_[t].row(), c = triplets_[t].col();
+      tripletKey_[t] = {r, c};
+      const int* begin = A_.innerIndexPtr() + A_.outerIndexPtr()[c];
+      const int* end = A_.innerIndexPtr() + A_.outerIndexPtr()[c + 1];
+      tripletSlot_[t] = int(std::lower_bound(begin, end, r) - A_.innerIndexPtr());
+    }
+    diagonalSlot_.resize(size_t(m));
+    for (int j = 0; j < m; ++j) {
+      const int* begin = A_.innerIndexPtr() + A_.outerIndexPtr()[j];
+      const int* end = A_.innerIndexPtr() + A_.outerIndexPtr()[j + 1];
+      diagonalSlot_[size_t(j)] = int(std::lower_bound(begin, end, j) - A_.innerIndexPtr());
+    }
+    keptRows_ = m;
+  } else {
+    // setFromTriplets starts each entry from its first triplet's value; 0 + x is x, so the sums agree.
+    Real* value = A_.valuePtr();
+    std::fill(value, value + A_.nonZeros(), Real(0));
+    for (size_t t = 0; t < nt; ++t) value[tripletSlot_[t]] += triplets_[t].value();
+  }
+  for (int j = 0; j < m; ++j) A_.valuePtr()[diagonalSlot_[size_t(j)]] *= 1 + kRegularisation;
+}
+
 namespace {
 
 /// What is left of row q's equation J v + e lambda = rhs.
@@ -183,9 +222,7 @@ CoarseCorrection::Result CoarseCorrection::apply(std::vector<ConstraintRow>& row
       }
     }
   }
-  A_.resize(m, m);
-  A_.setFromTriplets(triplets_.begin(), triplets_.end());
-  for (int j = 0; j < m; ++j) A_.coeffRef(j, j) *= 1 + kRegularisation;
+  assemble(m);
   // Symbolic analysis only when the pattern changed (the contact set of a resting scene holds for many steps).
   const bool same = analysed_ && int(patternOuter_.size()) == m + 1 &&
                     std::equal(patternOuter_.begin(), patternOuter_.end(), A_.outerIndexPtr()) &&

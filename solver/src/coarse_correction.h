@@ -89,6 +89,12 @@ class CoarseCorrection {
   std::vector<Real> residual_;
   std::vector<std::vector<std::pair<int, int>>> byBody_;
   std::vector<Eigen::Triplet<Real>> triplets_;
+  // The kept assembly (assemble): last call's triplet (row, column) sequence, each triplet's and each diagonal's
+  // index in A_'s value array, and A_'s size (-1: none kept).
+  void assemble(int m);
+  std::vector<std::pair<int, int>> tripletKey_;
+  std::vector<int> tripletSlot_, diagonalSlot_;
+  int keptRows_ = -1;
   Eigen::SparseMatrix<Real> A_, held_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<Real>, Eigen::Lower> ldlt_;
   std::vector<int> patternOuter_, patternInner_;
