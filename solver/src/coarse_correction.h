@@ -78,6 +78,10 @@ class CoarseCorrection {
   enum Kind : uint8_t { LOAD, TILT, FRICTION };
   void addGroup(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& sb, uint32_t coupling,
                 Kind kind);
+  /// A_ from triplets_ for m unknowns, each diagonal times 1 + kRegularisation: the values added straight into
+  /// the kept matrix while the triplets' (row, column) sequence is last call's (the same sums in the same order),
+  /// else setFromTriplets and a new kept pattern (coarse_correction.cpp).
+  void assemble(int m);
 
   // Groups: entries [entryBegin[g], entryBegin[g + 1]) of (row, weight).
   std::vector<uint32_t> entryBegin_;
@@ -91,7 +95,6 @@ class CoarseCorrection {
   std::vector<Eigen::Triplet<Real>> triplets_;
   // The kept assembly (assemble): last call's triplet (row, column) sequence, each triplet's and each diagonal's
   // index in A_'s value array, and A_'s size (-1: none kept).
-  void assemble(int m);
   std::vector<std::pair<int, int>> tripletKey_;
   std::vector<int> tripletSlot_, diagonalSlot_;
   int keptRows_ = -1;
