@@ -26,6 +26,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <new>
+#include <thread>
 #include <vector>
 
 #include "cpu_time.h"
@@ -187,6 +188,64 @@ void BM_pyramid_partitioned_scaling(benchmark::State& state) {
 }
 BENCHMARK(BM_pyramid_partitioned_scaling)
     ->Args({20, 1})->Args({20, 2})->Args({30, 1})->Args({30, 2})->Args({40, 1})->Args({40, 2})
+    ->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The ceiling of a two-thread step on this host: two independent pyramids of `rows` rows, each in its own
+// Simulation (one thread each, default settings), Args = (rows, threads). On one thread the program thread steps
+// both; on two, a second std::thread steps the second pyramid at the same time, with one spin handshake per step.
+// Nothing is shared between the two, so this is what a step whose every stage kept its region's data on its own
+// thread (no boundary, no barrier) could gain at most. rows 14 gives 2 x 105 boxes, pyramid20's 210; 21 and 28
+// match pyramid30 and pyramid40 (2 x 231, 2 x 406). median_ms is the wall time of one step of both pyramids
+// (docs/solver-internals.md "The ceiling of two threads"). A third argument of 1 makes the two threads swap
+// pyramids every step (the program thread steps pyramid a on even steps and b on odd ones): the same work with
+// every pyramid's data moving between the cores each step, which is what a stage moved alone to the second thread
+// pays.
+void BM_independent_pyramids(benchmark::State& state) {
+  const int rows = int(state.range(0));
+  const bool two = state.range(1) == 2;
+  const bool swap = state.range(2) == 1;
+  setNumThreads(1);
+  std::vector<double> wall;
+  double driftCm = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    PyramidScene a = buildPyramid(rows), b = buildPyramid(rows);
+    std::atomic<int> go{0}, done{0};
+    std::thread worker;
+    if (two)
+      worker = std::thread([&] {
+        for (int i = 1; i <= b.numSteps; ++i) {
+          while (go.load(std::memory_order_acquire) < i) {
+          }
+          (swap && i % 2 == 0 ? a : b).step();
+          done.store(i, std::memory_order_release);
+        }
+      });
+    state.ResumeTiming();
+    for (int i = 1; i <= a.numSteps; ++i) {
+      const auto t0 = Clock::now();
+      if (two) go.store(i, std::memory_order_release);
+      (two && swap && i % 2 == 0 ? b : a).step();
+      if (two) {
+        while (done.load(std::memory_order_acquire) < i) {
+        }
+      } else {
+        b.step();
+      }
+      wall.push_back(std::chrono::duration<double>(Clock::now() - t0).count() * 1e3);
+    }
+    state.PauseTiming();
+    if (worker.joinable()) worker.join();
+    driftCm = std::max(measurePyramid(a).maxDisplacement, measurePyramid(b).maxDisplacement) * 100;
+    state.ResumeTiming();
+  }
+  std::nth_element(wall.begin(), wall.begin() + long(wall.size() / 2), wall.end());
+  state.counters["median_ms"] = wall[wall.size() / 2];
+  state.counters["drift_cm"] = driftCm;
+}
+BENCHMARK(BM_independent_pyramids)
+    ->Args({14, 1, 0})->Args({14, 2, 0})->Args({14, 2, 1})->Args({21, 1, 0})->Args({21, 2, 0})->Args({21, 2, 1})
+    ->Args({28, 1, 0})->Args({28, 2, 0})->Args({28, 2, 1})
     ->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_tower10_stages(benchmark::State& state) {
