@@ -3,7 +3,8 @@
 // Independent Simulations stepped on separate threads at the same time (docs/solvers.md "Several simulations
 // on several threads"): each gives the bits it gives when the Simulations are stepped one after the
 // other on one thread. What the Simulations share is the logger and the collision-group names (both behind a
-// mutex) and the persistent team of the partitioned sweeps (a second caller that finds it busy runs its job on
+// mutex), the atomic counters that number bodies, geometries, materials and grippers' groups, and the
+// persistent team of the partitioned sweeps (a second caller that finds it busy runs its job on
 // its own thread, which gives the same bits). This is what bench_rigid_stages BM_independent_pyramids measures
 // (about 2x on two cores, docs/solver-internals.md "The ceiling of two threads").
 #include <doctest/doctest.h>
@@ -11,11 +12,13 @@
 #include <cstring>
 #include <functional>
 #include <latch>
+#include <set>
 #include <thread>
 #include <vector>
 
 #include "scenes/scenes.h"
 #include "scree/core/parallel.h"
+#include "scree/model/suction_gripper.h"
 
 using namespace scree;
 
@@ -96,6 +99,26 @@ TEST_CASE("two Simulations stepped at once on two threads give the bits of the s
     // The two pyramids differ, so the comparison above can tell them apart.
     CHECK(refA.size() != refB.size());
   }
+}
+
+TEST_CASE("suction grippers made on two threads at once get distinct collision groups") {
+  // Each SuctionGripper takes a collision group of its own, numbered by a process-wide counter, so that its
+  // holder, cups and sensors do not collide with each other. Two threads that build scenes with grippers at once
+  // must not hand out one number twice (a plain counter did: a data race, which the ThreadSanitizer stage of CI
+  // reports, and two grippers that could share a group).
+  constexpr int kPerThread = 500;
+  std::vector<uint32_t> mine(kPerThread), theirs(kPerThread);
+  std::latch start(2);
+  auto make = [&](std::vector<uint32_t>& groups) {
+    start.arrive_and_wait();
+    for (uint32_t& g : groups) g = std::make_shared<SuctionGripper>()->getCollisionGroup();
+  };
+  std::thread other([&] { make(theirs); });
+  make(mine);
+  other.join();
+  std::set<uint32_t> all(mine.begin(), mine.end());
+  all.insert(theirs.begin(), theirs.end());
+  CHECK(all.size() == size_t(2 * kPerThread));
 }
 
 }  // TEST_SUITE

@@ -10,6 +10,7 @@
 #include "scree/model/suction_gripper.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -22,9 +23,11 @@ namespace scree {
 
 namespace {
 constexpr Real kPi = 3.14159265358979323846;
+// Atomic: simulations may be built on several threads at once (docs/solvers.md "Several simulations on several
+// threads"), and two grippers must never share a group.
 uint32_t nextGripperGroup() {
-  static uint32_t counter = 0;
-  return Geometry::groupId("scree.suction.gripper." + std::to_string(counter++));
+  static std::atomic<uint32_t> counter{0};
+  return Geometry::groupId("scree.suction.gripper." + std::to_string(counter.fetch_add(1)));
 }
 }  // namespace
 
