@@ -39,9 +39,15 @@ namespace {
 // sleep bounded; elsewhere the standard library's wait and notify (not bounded: the lost wake-up below was only seen
 // on Linux, the platform CI runs on).
 //
-// A sleeper counts itself in `gSleepers` (a locked read-modify-write, a full fence) before the kernel compares the
-// value; a waker stores the value, fences, and skips the system call only when nobody sleeps. One of the two sees
-// the other's write, as in the store-buffering pattern with fences on both sides.
+// A sleeper counts itself in `gSleepers` (a read-modify-write) before the kernel compares the value; a waker stores
+// the value, then reads the count with a read-modify-write too (adding 0), and skips the system call only when
+// nobody sleeps. Both read-modify-writes are in the one modification order of `gSleepers`: if the sleeper's comes
+// first, the waker reads a count of at least 1 and wakes it; if the waker's comes first, the sleeper's acquires the
+// waker's release, so the sleeper's load (and the kernel's compare) sees the new value and does not sleep.
+// DESIGN (December 2026): the waker used to fence (`atomic_thread_fence`) and load the count. That is as correct
+// (the store-buffering pattern with fences on both sides), but ThreadSanitizer does not model fences, so CI's TSan
+// stage could not check this hand-off; with the read-modify-write the argument is plain happens-before, which TSan
+// follows. Cost: BM_team_barrier/2 unchanged within its noise (docs/solver-internals.md, the persistent team).
 //
 // The bound (parallel.h, publish): with std::atomic::wait, and then with the futex waking unconditionally,
 // bench_rigid_stages BM_team_barrier still hung now and then in the KVM guest it was measured on: one thread
@@ -91,9 +97,8 @@ void spinWhile(Waiting waiting) {
 }
 
 void wakeAll(std::atomic<uint32_t>& a) {
-  std::atomic_thread_fence(std::memory_order_seq_cst);
 #ifdef __linux__
-  if (gSleepers.load(std::memory_order_relaxed) == 0) return;
+  if (gSleepers.fetch_add(0, std::memory_order_acq_rel) == 0) return;
   syscall(SYS_futex, reinterpret_cast<uint32_t*>(&a), FUTEX_WAKE_PRIVATE, INT_MAX, nullptr, nullptr, 0);
 #else
   a.notify_all();
