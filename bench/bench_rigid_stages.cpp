@@ -71,7 +71,7 @@ void runStages(benchmark::State& state, Build build, Drift drift, int threadCoun
   setNumThreads(threads);
   std::vector<double> wall;
   StepTimings sum;
-  double cpu = 0, driftCm = 0;
+  double cpu = 0, driftCm = 0, sweepThreads = 0, rowThreads = 0;
   long steps = 0, allocSteps = 0, allocs = 0;
   uint64_t fp = 0;
   for (auto _ : state) {
@@ -90,6 +90,8 @@ void runStages(benchmark::State& state, Build build, Drift drift, int threadCoun
         ++allocSteps;
       }
       sum += s.sim->getTimings();
+      sweepThreads += s.sim->getSolver().getStats().numSweepThreads;
+      rowThreads += s.sim->getSolver().getStats().numRowBuildThreads;
       ++steps;
     }
     driftCm = drift(s) * 100;
@@ -112,6 +114,10 @@ void runStages(benchmark::State& state, Build build, Drift drift, int threadCoun
   state.counters["drift_cm"] = driftCm;
   state.counters["allocs"] = double(allocs) / double(std::max(1L, allocSteps));
   state.counters["fingerprint"] = double(fp & 0xffffffffu);
+  // The mean thread counts of the sweeps and of the contact row build over the steps (SolverStats): with the
+  // adaptive count, the share of steps that ran on two threads is (count - 1).
+  state.counters["sweep_threads"] = sweepThreads / n;
+  state.counters["row_threads"] = rowThreads / n;
 }
 
 /// runStages on one thread, for benchmarks whose argument is not the thread count.

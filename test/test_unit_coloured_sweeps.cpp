@@ -5,6 +5,7 @@
 // threads.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <chrono>
@@ -162,13 +163,19 @@ namespace {
 /// scene's 600) with partitioned sweeps on `threads` threads.
 // Adaptive thread count off: the 2-thread run must really run on two threads (with it on, the count would follow
 // the host's timing; the bits would not change, but the comparison would test less).
-std::pair<std::vector<Real>, scenes::PyramidMetrics> runPartitioned(int threads, bool shock, int steps) {
+// rowThreads (if given): the fewest threads the contact rows were built on over the steps.
+std::pair<std::vector<Real>, scenes::PyramidMetrics> runPartitioned(int threads, bool shock, int steps,
+                                                                    int* rowThreads = nullptr) {
   setNumThreads(threads);
   scenes::PyramidScene s = scenes::buildPyramid20();
   s.sim->getSolver().setUsePartitionedSweeps(true);
   s.sim->getSolver().setUseAdaptiveSweepThreads(false);
   s.sim->getSolver().setUseShockPropagation(shock);
-  for (int i = 0; i < (steps > 0 ? steps : s.numSteps); ++i) s.step();
+  if (rowThreads) *rowThreads = threads;
+  for (int i = 0; i < (steps > 0 ? steps : s.numSteps); ++i) {
+    s.step();
+    if (rowThreads) *rowThreads = std::min(*rowThreads, s.sim->getSolver().getStats().numRowBuildThreads);
+  }
   setNumThreads(1);
   return {pyramidState(s), scenes::measurePyramid(s)};
 }
@@ -184,9 +191,15 @@ TEST_CASE("partitioned sweeps: pyramid20 is bit-identical on 1 and 2 threads, wi
     // Without the shock pass 150 steps (2.5 s) suffice to compare bits (the 2-thread runs are slow on a loaded
     // machine; docs/solver-internals.md "Partitioned sweeps").
     const int steps = shock ? 0 : 150;
-    const auto [one, m1] = runPartitioned(1, shock, steps);
-    const auto [two, m2] = runPartitioned(2, shock, steps);
+    int rowsOne = 0, rowsTwo = 0;
+    const auto [one, m1] = runPartitioned(1, shock, steps, &rowsOne);
+    const auto [two, m2] = runPartitioned(2, shock, steps, &rowsTwo);
     REQUIRE(one.size() == two.size());
+    // The contact rows too were built on two threads in every step of the 2-thread run (pyramid20 has about 400
+    // contacts, above the build's threshold of 128), and on one in the 1-thread run: the bits below then also
+    // check that each thread's half gives the serial build's rows (contact_rows.cpp).
+    CHECK(rowsOne == 1);
+    if (twoThreads) CHECK(rowsTwo == 2);
     // Bit for bit: the two regions touch disjoint dynamic bodies (sweeps), and each shock range waits for the
     // writers of its frozen body (shock pass), so the thread count cannot change the result.
     CHECK(std::memcmp(one.data(), two.data(), one.size() * sizeof(Real)) == 0);
@@ -198,6 +211,63 @@ TEST_CASE("partitioned sweeps: pyramid20 is bit-identical on 1 and 2 threads, wi
       CHECK(m1.stands);
       CHECK(m1.maxDisplacement < 0.01);
     }
+  }
+}
+
+TEST_CASE("contact rows built on two threads: the serial build's bits for every kind of contact row") {
+  // The row build of the partitioned path (contact_rows.cpp) cuts the contacts in halves, counts each half's rows
+  // on its thread, places them, then fills them. Its count must agree with the fill for every row layout, not
+  // only pyramid20's manifold friction. A 12-row pyramid (78 boxes) beside a row of 48 spheres on the ground, in
+  // three variants: the default (box manifolds with manifold friction and single sphere points), rolling
+  // resistance (per-point friction and rolling rows), and the box friction model (per-point box friction). 90
+  // steps: the spheres land at step 20-25 and the contacts' warm starts and anchors are in use.
+  setNumThreads(2);
+  const bool twoThreads = getNumThreads() == 2;
+  setNumThreads(1);
+  for (int variant = 0; variant < 3; ++variant) {
+    CAPTURE(variant);
+    auto run = [variant](int threads, int& rowThreads, size_t& contacts) {
+      setNumThreads(threads);
+      scenes::PyramidScene s = scenes::buildPyramid(12);
+      for (int i = 0; i < 48; ++i) {
+        auto geom = std::make_shared<Geometry>(std::make_shared<Sphere>(0.3));
+        geom->setMaterial(s.material);
+        auto body = std::make_shared<RigidBody>();
+        body->add(geom);
+        body->setMass(2.0);
+        body->setPosition(Vec3(-8.0 + 0.7 * (i % 24), 3.0 + 1.5 * (i / 24), 2.0 + 0.01 * i));
+        s.sim->add(body);
+      }
+      if (variant == 1) s.contactMaterial->setRollingResistanceCoefficient(0.05);
+      if (variant == 2) s.contactMaterial->setFrictionModel(std::make_shared<BoxFrictionModel>());
+      s.sim->getSolver().setUsePartitionedSweeps(true);
+      s.sim->getSolver().setUseAdaptiveSweepThreads(false);
+      rowThreads = threads;
+      for (int i = 0; i < 90; ++i) {
+        s.step();
+        if (i >= 30) rowThreads = std::min(rowThreads, s.sim->getSolver().getStats().numRowBuildThreads);
+      }
+      contacts = s.sim->getContacts().size();
+      setNumThreads(1);
+      std::vector<Real> state;
+      for (const RigidBodyRef& b : s.sim->getRigidBodies()) {
+        for (const Vec3& v : {b->getPosition(), b->getVelocity(), b->getAngularVelocity()})
+          state.insert(state.end(), v.data(), v.data() + 3);
+        const Quat q = b->getRotation();
+        state.insert(state.end(), {q.w(), q.x(), q.y(), q.z()});
+      }
+      return state;
+    };
+    int rowsOne = 0, rowsTwo = 0;
+    size_t contactsOne = 0, contactsTwo = 0;
+    const std::vector<Real> one = run(1, rowsOne, contactsOne);
+    const std::vector<Real> two = run(2, rowsTwo, contactsTwo);
+    CHECK(contactsOne >= 128);  // the build's threshold for a second thread
+    CHECK(contactsOne == contactsTwo);
+    CHECK(rowsOne == 1);
+    if (twoThreads) CHECK(rowsTwo == 2);
+    REQUIRE(one.size() == two.size());
+    CHECK(std::memcmp(one.data(), two.data(), one.size() * sizeof(Real)) == 0);
   }
 }
 

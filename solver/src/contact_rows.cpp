@@ -4,7 +4,10 @@
 // particle rows stage, which hands this step's particle contacts to the particle stage (granular_stage.h).
 #include "contact_rows.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include "scree/core/parallel.h"
 
 #include "contact_law.h"
 #include "friction_anchor.h"
@@ -15,324 +18,445 @@ namespace scree::detail {
 
 namespace {
 constexpr uint32_t kMaxBlockPoints = 16;  ///< largest manifold solved as a block (pgs.cpp kMaxNormalBlock)
-}  // namespace
 
-void buildContactRows(SimulationState& s) {
-  const Real h = s.h;
-  const Solver& solver = s.solver;
-  s.rows.clear();
-  s.pointRows.clear();
-  s.couplings.clear();
-  s.frictionAnchors.beginStep();  // issue 18 (friction anchors)
-  const bool anchors = solver.getUseFrictionAnchors();
-  const ContactLawSettings law{h, solver.getRestitutionThreshold(), solver.getMaxPenetrationRecoverySpeed()};
-  const bool warm = solver.getUseWarmStarting();
-  size_t numPoints = 0, numWarm = 0, numSolvedContacts = 0;
+/// What contactRows does with one contact: COUNT its rows and points only; APPEND them to the step's arrays
+/// (the serial build); FILL them at the cursor's places in arrays already sized (the parallel build).
+enum class RowMode { COUNT, APPEND, FILL };
+
+/// The step's row-build settings, read once.
+struct RowBuildSettings {
+  Real h;
+  ContactLawSettings law;
+  bool warm, anchors, useBlock, useManifoldFriction;
+};
+
+/// Where a contact's rows, points and coupling go, and what the build tallies; one per thread.
+struct RowCursor {
+  uint32_t row = 0, point = 0, coupling = 0;
+  size_t warmCursor = 0;  ///< WarmStartCache::pairRangeAscending's
+  size_t numPoints = 0, numWarm = 0, numSolved = 0;
   bool nonIterative = false;
+  std::vector<FrictionAnchorCache::Active>* anchors = nullptr;  ///< this thread's anchored manifolds
+};
+
+/// The rows of contact ci: returns how many rows and contact points it takes ({0, 0}: not solved) and, unless
+/// mode is COUNT, writes them (rows, points, coupling, anchor) at the cursor and advances it. A contact's rows
+/// depend only on the contact, its bodies and the caches, never on the other contacts: so the parallel build
+/// gives the serial build's bits.
+// A template on the mode, so that the serial build (APPEND) carries no test of the others.
+template <RowMode mode>
+std::pair<uint32_t, uint32_t> contactRows(SimulationState& s, uint32_t ci, const RowBuildSettings& k, RowCursor& cur) {
   const Vec3 zero = Vec3::Zero();
-  s.warmStart.resetCursor();
+  GeometryContact& c = s.contacts[ci];
+  if (!c.isEnabled() || c.isSensor()) return {};
+  const int ia = s.solverIndex(c.rigidBody(0)), ib = s.solverIndex(c.rigidBody(1));
+  const bool dynA = ia >= 0 && s.sb[ia].invMass > 0, dynB = ib >= 0 && s.sb[ib].invMass > 0;
+  if (!dynA && !dynB) return {};
+  const SurfaceParameters& mat = c.material();
+  const FrictionModel* fm = c.frictionModel();
+  const FrictionModel::Type ftype = fm ? fm->getType() : FrictionModel::ITERATIVE_PROJECTED_CONE;
+  const FrictionModel::SolveType solveType = fm ? fm->getSolveType() : FrictionModel::ITERATIVE;
 
-  for (uint32_t ci = 0; ci < s.contacts.size(); ++ci) {
-    GeometryContact& c = s.contacts[ci];
-    if (!c.isEnabled() || c.isSensor()) continue;
-    const int ia = s.solverIndex(c.rigidBody(0)), ib = s.solverIndex(c.rigidBody(1));
-    const bool dynA = ia >= 0 && s.sb[ia].invMass > 0, dynB = ib >= 0 && s.sb[ib].invMass > 0;
-    if (!dynA && !dynB) continue;
-    const SurfaceParameters& mat = c.material();
-    const FrictionModel* fm = c.frictionModel();
-    const FrictionModel::Type ftype = fm ? fm->getType() : FrictionModel::ITERATIVE_PROJECTED_CONE;
-    const FrictionModel::SolveType solveType = fm ? fm->getSolveType() : FrictionModel::ITERATIVE;
-    if (solveType != FrictionModel::ITERATIVE) nonIterative = true;
-    const uint64_t pair = contactPairKey(c);
-    const Vec3 xa = ia >= 0 ? BodyAccess::cm(*s.bodies[ia]) : zero;
-    const Vec3 xb = ib >= 0 ? BodyAccess::cm(*s.bodies[ib]) : zero;
-    // Start-of-step and free (after forces) velocities of both sides.
-    const Vec3 va0 = ia >= 0 ? s.vStart[ia] : zero, wa0 = ia >= 0 ? s.wStart[ia] : zero;
-    const Vec3 vb0 = ib >= 0 ? s.vStart[ib] : zero, wb0 = ib >= 0 ? s.wStart[ib] : zero;
-    const Vec3 vaF = ia >= 0 ? s.sb[ia].v : zero, waF = ia >= 0 ? s.sb[ia].w : zero;
-    const Vec3 vbF = ib >= 0 ? s.sb[ib].v : zero, wbF = ib >= 0 ? s.sb[ib].w : zero;
-
-    // Rolling resistance: resisting torque about the tangents bounded by coefficient * r_eff * normal force,
-    // r_eff the harmonic combination of the rolling radii (the single radius against a flat shape).
-    Real rollMu = 0;
-    if (mat.getRollingResistanceCoefficient() > 0) {
-      const Real r0 = rollingRadius(c.geometry(0)), r1 = rollingRadius(c.geometry(1));
-      const Real reff = (r0 > 0 && r1 > 0) ? r0 * r1 / (r0 + r1) : std::max(r0, r1);
-      rollMu = mat.getRollingResistanceCoefficient() * reff;
-    }
-    // Count active points to lay out rows: [friction and rolling rows of all points][normal rows].
-    auto& pts = c.points();
-    uint32_t nActive = 0, nFriction = 0;
+  // Rolling resistance: resisting torque about the tangents bounded by coefficient * r_eff * normal force,
+  // r_eff the harmonic combination of the rolling radii (the single radius against a flat shape).
+  Real rollMu = 0;
+  if (mat.getRollingResistanceCoefficient() > 0) {
+    const Real r0 = rollingRadius(c.geometry(0)), r1 = rollingRadius(c.geometry(1));
+    const Real reff = (r0 > 0 && r1 > 0) ? r0 * r1 / (r0 + r1) : std::max(r0, r1);
+    rollMu = mat.getRollingResistanceCoefficient() * reff;
+  }
+  // Count active points to lay out rows: [friction and rolling rows of all points][normal rows].
+  auto& pts = c.points();
+  uint32_t nActive = 0, nFriction = 0;
+  for (const ContactPoint& p : pts) {
+    if (!p.enabled) continue;
+    ++nActive;
+    const Real mu = p.frictionCoefficient >= 0 ? p.frictionCoefficient : mat.getFrictionCoefficient();
+    if (mu > 0) nFriction += 2;
+    if (rollMu > 0) nFriction += 2;
+  }
+  if (nActive == 0) return {};
+  // Manifold treatment (contact_rows.h, DESIGN): the normal block needs one common normal; manifold friction
+  // also needs one friction law for all points.
+  auto muOf = [&mat](const ContactPoint& p) {
+    return p.frictionCoefficient >= 0 ? p.frictionCoefficient : mat.getFrictionCoefficient();
+  };
+  const ContactPoint* first = nullptr;
+  const bool useBlock = k.useBlock, useManifoldFriction = k.useManifoldFriction;
+  bool block = (useBlock || useManifoldFriction) && nActive >= 2 && nActive <= kMaxBlockPoints &&
+               solveType == FrictionModel::ITERATIVE;
+  bool manifoldFriction = useManifoldFriction && rollMu == 0 && ftype != FrictionModel::BOX;
+  Vec3 centre = zero;
+  // The normal block solves the manifold on its centre-and-tilt coordinates (pgs.cpp), which is the exact block
+  // solution only when the rows' compliances are equal: with per-point Young's moduli or damping times (the
+  // terrain's deformer contacts mix points 1000x softer than the rest) the affine load it imposes would load
+  // the soft points like the stiff ones. Such manifolds keep their rows one by one.
+  bool sameLaw = true;
+  for (const ContactPoint& p : pts) {
+    if (!p.enabled) continue;
+    if (!first) first = &p;
+    centre += p.point;
+    sameLaw = sameLaw && p.youngsModulus == first->youngsModulus && p.damping == first->damping;
+    block = block && p.normal.dot(first->normal) > 1 - 1e-9;
+    manifoldFriction = manifoldFriction && muOf(p) > 0 && muOf(p) == muOf(*first) &&
+                       p.frictionDirection == zero && p.surfaceVelocity == first->surfaceVelocity;
+  }
+  manifoldFriction = manifoldFriction && block;
+  // The count needs the principal axes of no manifold: only whether manifold friction has a lever (below).
+  if constexpr (mode == RowMode::COUNT)
+    if (!manifoldFriction) return {nFriction + nActive, nActive};
+  // The points' offsets from the centre in the tangent plane, along the principal axes of their spread, scaled
+  // so that sum(u^2) = sum(v^2) = nActive (a degenerate axis -- collinear or coincident points -- stays 0).
+  Real blockU[kMaxBlockPoints], blockV[kMaxBlockPoints];  // filled for the active points when block
+  Vec3 arm[kMaxBlockPoints];
+  Vec3 mt1 = zero, mt2 = zero;
+  Real rEff = 0, sumR2 = 0;
+  if (block) {
+    const Vec3 n0 = first->normal;
+    centre /= Real(nActive);
+    orthonormalBasis(n0, mt1, mt2);
+    Real a = 0, b = 0, cc = 0;
+    uint32_t k = 0;
     for (const ContactPoint& p : pts) {
       if (!p.enabled) continue;
-      ++nActive;
-      const Real mu = p.frictionCoefficient >= 0 ? p.frictionCoefficient : mat.getFrictionCoefficient();
-      if (mu > 0) nFriction += 2;
-      if (rollMu > 0) nFriction += 2;
+      const Vec3 d = p.point - centre;
+      arm[k] = d - n0.dot(d) * n0;
+      const Real x = arm[k].dot(mt1), y = arm[k].dot(mt2);
+      a += x * x;
+      b += x * y;
+      cc += y * y;
+      rEff += arm[k].norm();
+      sumR2 += arm[k].squaredNorm();
+      ++k;
     }
-    if (nActive == 0) continue;
-    // Manifold treatment (contact_rows.h, DESIGN): the normal block needs one common normal; manifold friction
-    // also needs one friction law for all points.
-    auto muOf = [&mat](const ContactPoint& p) {
-      return p.frictionCoefficient >= 0 ? p.frictionCoefficient : mat.getFrictionCoefficient();
-    };
-    const ContactPoint* first = nullptr;
-    const bool useBlock = solver.getUseManifoldNormalBlock(), useManifoldFriction = solver.getUseManifoldFriction();
-    bool block = (useBlock || useManifoldFriction) && nActive >= 2 && nActive <= kMaxBlockPoints &&
-                 solveType == FrictionModel::ITERATIVE;
-    bool manifoldFriction = useManifoldFriction && rollMu == 0 && ftype != FrictionModel::BOX;
-    Vec3 centre = zero;
-    // The normal block solves the manifold on its centre-and-tilt coordinates (pgs.cpp), which is the exact block
-    // solution only when the rows' compliances are equal: with per-point Young's moduli or damping times (the
-    // terrain's deformer contacts mix points 1000x softer than the rest) the affine load it imposes would load
-    // the soft points like the stiff ones. Such manifolds keep their rows one by one.
-    bool sameLaw = true;
-    for (const ContactPoint& p : pts) {
-      if (!p.enabled) continue;
-      if (!first) first = &p;
-      centre += p.point;
-      sameLaw = sameLaw && p.youngsModulus == first->youngsModulus && p.damping == first->damping;
-      block = block && p.normal.dot(first->normal) > 1 - 1e-9;
-      manifoldFriction = manifoldFriction && muOf(p) > 0 && muOf(p) == muOf(*first) &&
-                         p.frictionDirection == zero && p.surfaceVelocity == first->surfaceVelocity;
+    rEff /= Real(nActive);
+    if constexpr (mode == RowMode::COUNT)
+      return {rEff > 0 && sumR2 > 0 ? 3 + nActive : nFriction + nActive, nActive};
+    // The principal axis at theta = atan2(2b, a - cc) / 2, its cosine and sine from the double angle's by the
+    // half-angle formulas (the larger of the two by a square root, the other from sin 2theta = 2 sin cos):
+    // no atan2, sin or cos per manifold (libm's sincos was 1 % of pyramid20's step, issue 18).
+    const Real r2 = std::sqrt((a - cc) * (a - cc) + 4 * b * b);
+    Real ct = 1, st = 0;
+    if (r2 > 0) {
+      const Real c2 = (a - cc) / r2, s2 = 2 * b / r2;
+      if (c2 >= 0) {
+        ct = std::sqrt(0.5 * (1 + c2));
+        st = s2 / (2 * ct);
+      } else {
+        st = std::copysign(std::sqrt(0.5 * (1 - c2)), s2);
+        ct = s2 / (2 * st);
+      }
     }
-    manifoldFriction = manifoldFriction && block;
-    // The points' offsets from the centre in the tangent plane, along the principal axes of their spread, scaled
-    // so that sum(u^2) = sum(v^2) = nActive (a degenerate axis -- collinear or coincident points -- stays 0).
-    Real blockU[kMaxBlockPoints], blockV[kMaxBlockPoints];  // filled for the active points when block
-    Vec3 arm[kMaxBlockPoints];
-    Vec3 mt1 = zero, mt2 = zero;
-    Real rEff = 0, sumR2 = 0;
-    if (block) {
-      const Vec3 n0 = first->normal;
-      centre /= Real(nActive);
-      orthonormalBasis(n0, mt1, mt2);
-      Real a = 0, b = 0, cc = 0;
-      uint32_t k = 0;
-      for (const ContactPoint& p : pts) {
-        if (!p.enabled) continue;
-        const Vec3 d = p.point - centre;
-        arm[k] = d - n0.dot(d) * n0;
-        const Real x = arm[k].dot(mt1), y = arm[k].dot(mt2);
-        a += x * x;
-        b += x * y;
-        cc += y * y;
-        rEff += arm[k].norm();
-        sumR2 += arm[k].squaredNorm();
-        ++k;
-      }
-      rEff /= Real(nActive);
-      // The principal axis at theta = atan2(2b, a - cc) / 2, its cosine and sine from the double angle's by the
-      // half-angle formulas (the larger of the two by a square root, the other from sin 2theta = 2 sin cos):
-      // no atan2, sin or cos per manifold (libm's sincos was 1 % of pyramid20's step, issue 18).
-      const Real r2 = std::sqrt((a - cc) * (a - cc) + 4 * b * b);
-      Real ct = 1, st = 0;
-      if (r2 > 0) {
-        const Real c2 = (a - cc) / r2, s2 = 2 * b / r2;
-        if (c2 >= 0) {
-          ct = std::sqrt(0.5 * (1 + c2));
-          st = s2 / (2 * ct);
-        } else {
-          st = std::copysign(std::sqrt(0.5 * (1 - c2)), s2);
-          ct = s2 / (2 * st);
-        }
-      }
-      const Vec3 e1 = ct * mt1 + st * mt2, e2 = n0.cross(e1);
-      Real su = 0, sv = 0;
-      for (uint32_t i = 0; i < nActive; ++i) {
-        blockU[i] = arm[i].dot(e1);
-        blockV[i] = arm[i].dot(e2);
-        su += blockU[i] * blockU[i];
-        sv += blockV[i] * blockV[i];
-      }
-      const Real spread = a + cc;
-      const Real scaleU = su > 1e-10 * spread && spread > 0 ? std::sqrt(Real(nActive) / su) : 0.0;
-      const Real scaleV = sv > 1e-10 * spread && spread > 0 ? std::sqrt(Real(nActive) / sv) : 0.0;
-      for (uint32_t i = 0; i < nActive; ++i) {
-        blockU[i] *= scaleU;
-        blockV[i] *= scaleV;
-      }
-      // Friction at the centre needs a lever for the twist row: points spread around the centre.
-      manifoldFriction = manifoldFriction && rEff > 0 && sumR2 > 0;
+    const Vec3 e1 = ct * mt1 + st * mt2, e2 = n0.cross(e1);
+    Real su = 0, sv = 0;
+    for (uint32_t i = 0; i < nActive; ++i) {
+      blockU[i] = arm[i].dot(e1);
+      blockV[i] = arm[i].dot(e2);
+      su += blockU[i] * blockU[i];
+      sv += blockV[i] * blockV[i];
     }
-    if (manifoldFriction) nFriction = 3;
-    ++numSolvedContacts;
-    const int32_t base = int32_t(s.rows.size());
-    int32_t nextFriction = base;
-    int32_t nextNormal = base + int32_t(nFriction);
-    // The new rows are copies of the default row (constraint_row.h), filled in place below (setPointJacobian,
-    // contact_law.h).
-    s.rows.resize(s.rows.size() + nFriction + nActive, defaultConstraintRow());
-    s.couplings.push_back({ia, ib, uint32_t(base), nFriction + nActive, false});
-    // Weight-based normal impulse estimate for box friction on new contacts: the lighter dynamic body's weight.
-    const Real massA = dynA ? 1.0 / s.sb[ia].invMass : 0, massB = dynB ? 1.0 / s.sb[ib].invMass : 0;
-    const Real weightImpulse =
-        ((dynA && dynB) ? std::min(massA, massB) : std::max(massA, massB)) * s.gravity.norm() * h / Real(nActive);
+    const Real spread = a + cc;
+    const Real scaleU = su > 1e-10 * spread && spread > 0 ? std::sqrt(Real(nActive) / su) : 0.0;
+    const Real scaleV = sv > 1e-10 * spread && spread > 0 ? std::sqrt(Real(nActive) / sv) : 0.0;
+    for (uint32_t i = 0; i < nActive; ++i) {
+      blockU[i] *= scaleU;
+      blockV[i] *= scaleV;
+    }
+    // Friction at the centre needs a lever for the twist row: points spread around the centre.
+    manifoldFriction = manifoldFriction && rEff > 0 && sumR2 > 0;
+  }
+  if (manifoldFriction) nFriction = 3;
+  const uint32_t numRows = nFriction + nActive;
+  if constexpr (mode == RowMode::COUNT) return {numRows, nActive};
+  if (solveType != FrictionModel::ITERATIVE) cur.nonIterative = true;
+  const uint64_t pair = contactPairKey(c);
+  const Vec3 xa = ia >= 0 ? BodyAccess::cm(*s.bodies[ia]) : zero;
+  const Vec3 xb = ib >= 0 ? BodyAccess::cm(*s.bodies[ib]) : zero;
+  // Start-of-step and free (after forces) velocities of both sides.
+  const Vec3 va0 = ia >= 0 ? s.vStart[ia] : zero, wa0 = ia >= 0 ? s.wStart[ia] : zero;
+  const Vec3 vb0 = ib >= 0 ? s.vStart[ib] : zero, wb0 = ib >= 0 ? s.wStart[ib] : zero;
+  const Vec3 vaF = ia >= 0 ? s.sb[ia].v : zero, waF = ia >= 0 ? s.sb[ia].w : zero;
+  const Vec3 vbF = ib >= 0 ? s.sb[ib].v : zero, wbF = ib >= 0 ? s.sb[ib].w : zero;
+  ++cur.numSolved;
+  // The new rows are copies of the default row (constraint_row.h), filled in place below (setPointJacobian,
+  // contact_law.h).
+  if constexpr (mode == RowMode::APPEND) {
+    cur.row = uint32_t(s.rows.size());
+    s.rows.resize(s.rows.size() + numRows, defaultConstraintRow());
+  } else {
+    std::fill(s.rows.begin() + cur.row, s.rows.begin() + cur.row + numRows, defaultConstraintRow());
+  }
+  const int32_t base = int32_t(cur.row);
+  int32_t nextFriction = base;
+  int32_t nextNormal = base + int32_t(nFriction);
+  // The serial build appends its point records and coupling; the parallel build writes them at the places the
+  // count gave.
+  auto putPoint = [&s, &cur](const PointRows& pr) {
+    if constexpr (mode == RowMode::APPEND) s.pointRows.push_back(pr);
+    else s.pointRows[cur.point++] = pr;
+  };
+  const CouplingRange coupling{ia, ib, uint32_t(base), numRows, false};
+  if constexpr (mode == RowMode::APPEND) s.couplings.push_back(coupling);
+  else s.couplings[cur.coupling++] = coupling;
+  // Weight-based normal impulse estimate for box friction on new contacts: the lighter dynamic body's weight.
+  const Real massA = dynA ? 1.0 / s.sb[ia].invMass : 0, massB = dynB ? 1.0 / s.sb[ib].invMass : 0;
+  const Real weightImpulse =
+      ((dynA && dynB) ? std::min(massA, massB) : std::max(massA, massB)) * s.gravity.norm() * k.h / Real(nActive);
 
-    const int32_t firstNormal = nextNormal;
-    uint32_t activeIndex = 0;
-    const auto warmRange = warm ? s.warmStart.pairRangeAscending(pair)
-                                : std::pair<const WarmStartCache::Entry*, const WarmStartCache::Entry*>{};
-    Vec3 warmFriction = zero;  // manifold friction: sum of the points' cached friction impulses
-    Real warmTwist = 0;        // and their moment about the centre along the normal
-    for (uint32_t pi = 0; pi < pts.size(); ++pi) {
-      ContactPoint& p = pts[pi];
-      if (!p.enabled) continue;
-      ++numPoints;
-      const uint32_t ak = activeIndex++;
-      const Vec3& n = p.normal;
-      const Vec3 ra = p.point - xa, rb = p.point - xb;
-      const WarmStartCache::Entry* ce = warm ? WarmStartCache::find(warmRange, p.featureId, p.point) : nullptr;
-      if (ce) ++numWarm;
+  const int32_t firstNormal = nextNormal;
+  uint32_t activeIndex = 0;
+  const auto warmRange = k.warm ? s.warmStart.pairRangeAscending(pair, cur.warmCursor)
+                              : std::pair<const WarmStartCache::Entry*, const WarmStartCache::Entry*>{};
+  Vec3 warmFriction = zero;  // manifold friction: sum of the points' cached friction impulses
+  Real warmTwist = 0;        // and their moment about the centre along the normal
+  for (uint32_t pi = 0; pi < pts.size(); ++pi) {
+    ContactPoint& p = pts[pi];
+    if (!p.enabled) continue;
+    ++cur.numPoints;
+    const uint32_t ak = activeIndex++;
+    const Vec3& n = p.normal;
+    const Vec3 ra = p.point - xa, rb = p.point - xb;
+    const WarmStartCache::Entry* ce = k.warm ? WarmStartCache::find(warmRange, p.featureId, p.point) : nullptr;
+    if (ce) ++cur.numWarm;
 
-      // --- normal row (contact_law.h) ---
-      ConstraintRow& r = s.rows[nextNormal];
-      setPointJacobian(r, ia, ib, ra, rb, n);
-      r.solveType = solveType;
-      // The approach speeds from the Jacobian's values in registers, not read back from the row just stored:
-      // that read waited on the stores (perf: a tenth of buildContactRows' samples on pyramid20, issue 18). Same
-      // products in the same order as J v, so the same bits.
-      const Vec3 jAngA = ra.cross(n), jLinB = -n, jAngB = -rb.cross(n);
-      const Real E = p.youngsModulus > 0 ? p.youngsModulus : mat.getYoungsModulus();
-      const Real tau = p.damping >= 0 ? p.damping : mat.getDamping();
-      NormalContactState cs;
-      cs.depth = p.depth;
-      cs.vn0 = n.dot(va0) + jAngA.dot(wa0) + jLinB.dot(vb0) + jAngB.dot(wb0);
-      cs.vnFree = n.dot(vaF) + jAngA.dot(waF) + jLinB.dot(vbF) + jAngB.dot(wbF);
-      cs.rememberedImpact = ce ? ce->impactSpeed : 0;
-      // Adhesion: the contact's adhesive force is shared by its points; while the pair is in contact (points
-      // within the contact margin) the row may pull with up to that force towards the rest overlap.
-      cs.adhesiveForce = mat.getAdhesiveForce() / Real(nActive);
-      cs.adhesiveOverlap = mat.getAdhesiveOverlap();
-      cs.restitution = p.restitution >= 0 ? p.restitution : mat.getRestitution();
-      const NormalRowCoefficients nr = contactNormalRow(law, contactSpook(h, E, tau), cs);
-      r.rhs = nr.rhs;
-      r.e = nr.e;
-      r.lo = nr.lo;
-      r.hi = 1e300;
-      r.lambda = ce ? std::max(ce->normal, r.lo) : 0.0;
-      if (block && useBlock && sameLaw) {
-        r.blockBegin = firstNormal;
-        r.blockCount = int32_t(nActive);
-        r.blockU = blockU[ak];
-        r.blockV = blockV[ak];
-      }
-      if (manifoldFriction) {
-        if (ce) {
-          warmFriction += ce->friction;
-          warmTwist += first->normal.dot(arm[ak].cross(ce->friction));
-        }
-        PointRows pr{ci, pi, nextNormal, base, mt1, mt2, nr.impactSpeed};
-        pr.twist = base + 2;
-        pr.share = 1.0 / Real(nActive);
-        pr.twistArm = first->normal.cross(arm[ak]) / sumR2;
-        s.pointRows.push_back(pr);
-        ++nextNormal;
-        continue;
-      }
-
-      // --- friction rows ---
-      const Real mu = p.frictionCoefficient >= 0 ? p.frictionCoefficient : mat.getFrictionCoefficient();
-      int32_t t1Index = -1;
-      Vec3 t1, t2;
-      orthonormalBasis(n, t1, t2);
-      if (p.frictionDirection != Vec3::Zero()) {
-        // A listener's primary direction (e.g. a tire's rolling direction): its tangential part, if any.
-        const Vec3 d = p.frictionDirection - n.dot(p.frictionDirection) * n;
-        const Real len = d.norm();
-        if (len > 1e-9 * p.frictionDirection.norm()) {
-          t1 = d / len;
-          t2 = n.cross(t1);
-        }
-      }
-      if (mu > 0) {
-        t1Index = nextFriction;
-        const Real eVisc = spookVelocityRegularisation(h, mat.getSurfaceViscosity());
-        const Real lnEst = ce && ce->normal > 0 ? ce->normal : weightImpulse;
-        for (int k = 0; k < 2; ++k) {
-          const Vec3& t = k == 0 ? t1 : t2;
-          ConstraintRow& f = s.rows[nextFriction + k];
-          setPointJacobian(f, ia, ib, ra, rb, t);
-          f.rhs = p.surfaceVelocity.dot(t);
-          f.e = eVisc;
-          f.mu = mu;
-          f.solveType = solveType;
-          f.friction = true;
-          f.lambda = ce ? ce->friction.dot(t) : 0.0;
-          switch (ftype) {
-            case FrictionModel::BOX: {
-              const Real lim = std::isinf(mu) ? 1e300 : mu * lnEst;
-              f.lo = -lim;
-              f.hi = lim;
-              f.lambda = std::clamp(f.lambda, f.lo, f.hi);
-              break;
-            }
-            case FrictionModel::SCALED_BOX: f.normalRow = nextNormal; break;
-            case FrictionModel::ITERATIVE_PROJECTED_CONE:
-              f.normalRow = nextNormal;
-              if (k == 0) f.pairedRow = nextFriction + 1;
-              break;
-          }
-        }
-        nextFriction += 2;
-      }
-      if (rollMu > 0) {
-        // Two angular rows on the relative rotation about the tangents, solved as a disc like the cone.
-        for (int k = 0; k < 2; ++k) {
-          const Vec3& t = k == 0 ? t1 : t2;
-          ConstraintRow& f = s.rows[nextFriction + k];
-          f.bodyA = ia;
-          f.bodyB = ib;
-          f.jAngA = t;
-          f.jAngB = -t;
-          f.mu = rollMu;
-          f.normalRow = nextNormal;
-          f.solveType = solveType;
-          f.friction = true;
-          if (k == 0) f.pairedRow = nextFriction + 1;
-        }
-        nextFriction += 2;
-      }
-      s.pointRows.push_back({ci, pi, nextNormal, t1Index, t1, t2, nr.impactSpeed});
-      ++nextNormal;
+    // --- normal row (contact_law.h) ---
+    ConstraintRow& r = s.rows[nextNormal];
+    setPointJacobian(r, ia, ib, ra, rb, n);
+    r.solveType = solveType;
+    // The approach speeds from the Jacobian's values in registers, not read back from the row just stored:
+    // that read waited on the stores (perf: a tenth of buildContactRows' samples on pyramid20, issue 18). Same
+    // products in the same order as J v, so the same bits.
+    const Vec3 jAngA = ra.cross(n), jLinB = -n, jAngB = -rb.cross(n);
+    const Real E = p.youngsModulus > 0 ? p.youngsModulus : mat.getYoungsModulus();
+    const Real tau = p.damping >= 0 ? p.damping : mat.getDamping();
+    NormalContactState cs;
+    cs.depth = p.depth;
+    cs.vn0 = n.dot(va0) + jAngA.dot(wa0) + jLinB.dot(vb0) + jAngB.dot(wb0);
+    cs.vnFree = n.dot(vaF) + jAngA.dot(waF) + jLinB.dot(vbF) + jAngB.dot(wbF);
+    cs.rememberedImpact = ce ? ce->impactSpeed : 0;
+    // Adhesion: the contact's adhesive force is shared by its points; while the pair is in contact (points
+    // within the contact margin) the row may pull with up to that force towards the rest overlap.
+    cs.adhesiveForce = mat.getAdhesiveForce() / Real(nActive);
+    cs.adhesiveOverlap = mat.getAdhesiveOverlap();
+    cs.restitution = p.restitution >= 0 ? p.restitution : mat.getRestitution();
+    const NormalRowCoefficients nr = contactNormalRow(k.law, contactSpook(k.h, E, tau), cs);
+    r.rhs = nr.rhs;
+    r.e = nr.e;
+    r.lo = nr.lo;
+    r.hi = 1e300;
+    r.lambda = ce ? std::max(ce->normal, r.lo) : 0.0;
+    if (block && useBlock && sameLaw) {
+      r.blockBegin = firstNormal;
+      r.blockCount = int32_t(nActive);
+      r.blockU = blockU[ak];
+      r.blockV = blockV[ak];
     }
     if (manifoldFriction) {
-      // [t1, t2, twist] at the manifold's centre, bounded by the sum of its normal impulses (contact_rows.h).
-      const Real mu = muOf(*first);
-      const Real eVisc = spookVelocityRegularisation(h, mat.getSurfaceViscosity());
+      if (ce) {
+        warmFriction += ce->friction;
+        warmTwist += first->normal.dot(arm[ak].cross(ce->friction));
+      }
+      PointRows pr{ci, pi, nextNormal, base, mt1, mt2, nr.impactSpeed};
+      pr.twist = base + 2;
+      pr.share = 1.0 / Real(nActive);
+      pr.twistArm = first->normal.cross(arm[ak]) / sumR2;
+      putPoint(pr);
+      ++nextNormal;
+      continue;
+    }
+
+    // --- friction rows ---
+    const Real mu = p.frictionCoefficient >= 0 ? p.frictionCoefficient : mat.getFrictionCoefficient();
+    int32_t t1Index = -1;
+    Vec3 t1, t2;
+    orthonormalBasis(n, t1, t2);
+    if (p.frictionDirection != Vec3::Zero()) {
+      // A listener's primary direction (e.g. a tire's rolling direction): its tangential part, if any.
+      const Vec3 d = p.frictionDirection - n.dot(p.frictionDirection) * n;
+      const Real len = d.norm();
+      if (len > 1e-9 * p.frictionDirection.norm()) {
+        t1 = d / len;
+        t2 = n.cross(t1);
+      }
+    }
+    if (mu > 0) {
+      t1Index = nextFriction;
+      const Real eVisc = spookVelocityRegularisation(k.h, mat.getSurfaceViscosity());
+      const Real lnEst = ce && ce->normal > 0 ? ce->normal : weightImpulse;
       for (int k = 0; k < 2; ++k) {
-        const Vec3& t = k == 0 ? mt1 : mt2;
-        ConstraintRow& f = s.rows[base + k];
-        setPointJacobian(f, ia, ib, centre - xa, centre - xb, t);
-        f.rhs = first->surfaceVelocity.dot(t);
-        f.e = eVisc / Real(nActive);  // the points' viscous compliances act in parallel
+        const Vec3& t = k == 0 ? t1 : t2;
+        ConstraintRow& f = s.rows[nextFriction + k];
+        setPointJacobian(f, ia, ib, ra, rb, t);
+        f.rhs = p.surfaceVelocity.dot(t);
+        f.e = eVisc;
         f.mu = mu;
         f.solveType = solveType;
         f.friction = true;
-        f.lambda = warmFriction.dot(t);
-        f.normalRow = firstNormal;
-        f.normalCount = int32_t(nActive);
-        if (k == 0 && ftype == FrictionModel::ITERATIVE_PROJECTED_CONE) f.pairedRow = base + 1;
+        f.lambda = ce ? ce->friction.dot(t) : 0.0;
+        switch (ftype) {
+          case FrictionModel::BOX: {
+            const Real lim = std::isinf(mu) ? 1e300 : mu * lnEst;
+            f.lo = -lim;
+            f.hi = lim;
+            f.lambda = std::clamp(f.lambda, f.lo, f.hi);
+            break;
+          }
+          case FrictionModel::SCALED_BOX: f.normalRow = nextNormal; break;
+          case FrictionModel::ITERATIVE_PROJECTED_CONE:
+            f.normalRow = nextNormal;
+            if (k == 0) f.pairedRow = nextFriction + 1;
+            break;
+        }
       }
-      // Twist: torque about the normal. Point i slips at w r_i and its viscous row carries w r_i / e, a torque
-      // w r_i^2 / e, so the points together give e_twist = e / sum(r_i^2) (rad/s per N m s).
-      ConstraintRow& tw = s.rows[base + 2];
-      tw.bodyA = ia;
-      tw.bodyB = ib;
-      tw.jAngA = first->normal;
-      tw.jAngB = -first->normal;
-      tw.e = eVisc / sumR2;
-      tw.mu = std::isinf(mu) ? mu : mu * rEff;
-      tw.solveType = solveType;
-      tw.friction = true;
-      tw.lambda = warmTwist;
-      tw.normalRow = firstNormal;
-      tw.normalCount = int32_t(nActive);
-      // ---- issue 18 (friction anchors, friction_anchor.h): the position term of a sticking manifold ----
-      if (anchors && first->surfaceVelocity == zero)
-        anchorManifoldFriction(s, pair, ia, ib, centre, first->normal, mt1, mt2, rEff, base, base + 2,
-                               first->damping >= 0 ? first->damping : mat.getDamping());
+      nextFriction += 2;
     }
+    if (rollMu > 0) {
+      // Two angular rows on the relative rotation about the tangents, solved as a disc like the cone.
+      for (int k = 0; k < 2; ++k) {
+        const Vec3& t = k == 0 ? t1 : t2;
+        ConstraintRow& f = s.rows[nextFriction + k];
+        f.bodyA = ia;
+        f.bodyB = ib;
+        f.jAngA = t;
+        f.jAngB = -t;
+        f.mu = rollMu;
+        f.normalRow = nextNormal;
+        f.solveType = solveType;
+        f.friction = true;
+        if (k == 0) f.pairedRow = nextFriction + 1;
+      }
+      nextFriction += 2;
+    }
+    putPoint(PointRows{ci, pi, nextNormal, t1Index, t1, t2, nr.impactSpeed});
+    ++nextNormal;
+  }
+  if (manifoldFriction) {
+    // [t1, t2, twist] at the manifold's centre, bounded by the sum of its normal impulses (contact_rows.h).
+    const Real mu = muOf(*first);
+    const Real eVisc = spookVelocityRegularisation(k.h, mat.getSurfaceViscosity());
+    for (int k = 0; k < 2; ++k) {
+      const Vec3& t = k == 0 ? mt1 : mt2;
+      ConstraintRow& f = s.rows[base + k];
+      setPointJacobian(f, ia, ib, centre - xa, centre - xb, t);
+      f.rhs = first->surfaceVelocity.dot(t);
+      f.e = eVisc / Real(nActive);  // the points' viscous compliances act in parallel
+      f.mu = mu;
+      f.solveType = solveType;
+      f.friction = true;
+      f.lambda = warmFriction.dot(t);
+      f.normalRow = firstNormal;
+      f.normalCount = int32_t(nActive);
+      if (k == 0 && ftype == FrictionModel::ITERATIVE_PROJECTED_CONE) f.pairedRow = base + 1;
+    }
+    // Twist: torque about the normal. Point i slips at w r_i and its viscous row carries w r_i / e, a torque
+    // w r_i^2 / e, so the points together give e_twist = e / sum(r_i^2) (rad/s per N m s).
+    ConstraintRow& tw = s.rows[base + 2];
+    tw.bodyA = ia;
+    tw.bodyB = ib;
+    tw.jAngA = first->normal;
+    tw.jAngB = -first->normal;
+    tw.e = eVisc / sumR2;
+    tw.mu = std::isinf(mu) ? mu : mu * rEff;
+    tw.solveType = solveType;
+    tw.friction = true;
+    tw.lambda = warmTwist;
+    tw.normalRow = firstNormal;
+    tw.normalCount = int32_t(nActive);
+    // ---- issue 18 (friction anchors, friction_anchor.h): the position term of a sticking manifold ----
+    if (k.anchors && first->surfaceVelocity == zero)
+      anchorManifoldFriction(s, pair, ia, ib, centre, first->normal, mt1, mt2, rEff, base, base + 2,
+                             first->damping >= 0 ? first->damping : mat.getDamping(), *cur.anchors);
+  }
+  cur.row += numRows;
+  return {numRows, nActive};
+}
+
+/// Threads for the contact row build: the partitioned work's count for this step (beginPartitionedWork), one
+/// for few contacts. The build gives the same bits on any count.
+int rowBuildThreads(const SimulationState& s) {
+  constexpr size_t kMinContacts = 128;  // below this the team's two hand-overs cost more than half the build
+  if (!s.solver.getUsePartitionedSweeps() || s.contacts.size() < kMinContacts) return 1;
+  return std::max(1, std::min({s.partition.maxThreads, PgsPartition::kRegions, scree::getNumThreads()}));
+}
+
+}  // namespace
+
+void buildContactRows(SimulationState& s) {
+  const Solver& solver = s.solver;
+  beginPartitionedWork(s);  // the row build is the first stage of the partitioned work (sweep_threads.h)
+  s.frictionAnchors.beginStep();  // issue 18 (friction anchors)
+  const RowBuildSettings k{s.h,
+                           {s.h, solver.getRestitutionThreshold(), solver.getMaxPenetrationRecoverySpeed()},
+                           solver.getUseWarmStarting(),
+                           solver.getUseFrictionAnchors(),
+                           solver.getUseManifoldNormalBlock(),
+                           solver.getUseManifoldFriction()};
+  const uint32_t numContacts = uint32_t(s.contacts.size());
+  const int threads = rowBuildThreads(s);
+  s.solverStats().numRowBuildThreads = threads;
+  RowCursor tally[PgsPartition::kRegions];
+  if (threads == 1) {
+    s.rows.clear();
+    s.pointRows.clear();
+    s.couplings.clear();
+    tally[0].anchors = &s.frictionAnchors.active;
+    for (uint32_t ci = 0; ci < numContacts; ++ci) contactRows<RowMode::APPEND>(s, ci, k, tally[0]);
+  } else {
+    // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "The contact rows on the team"): the
+    // contacts cut in fixed halves by index. Each thread counts its half's rows and points; one prefix sum on
+    // the calling thread places every contact; each thread then fills its half in place, with its own warm-start
+    // cursor and its own list of anchored manifolds (appended in half order, i.e. contact order).
+    auto& layout = s.contactLayout;
+    layout.resize(numContacts);
+    auto half = [numContacts](int t, int n) {
+      return std::pair<uint32_t, uint32_t>{uint32_t(uint64_t(numContacts) * uint64_t(t) / uint64_t(n)),
+                                           uint32_t(uint64_t(numContacts) * uint64_t(t + 1) / uint64_t(n))};
+    };
+    runTeam(threads, [&](int t, int n) {
+      const auto [b, e] = half(t, n);
+      RowCursor scratch;
+      for (uint32_t ci = b; ci < e; ++ci) {
+        const auto [numRows, numPoints] = contactRows<RowMode::COUNT>(s, ci, k, scratch);
+        layout[ci] = {numRows, numPoints, 0, 0};
+      }
+    });
+    uint32_t row = 0, point = 0, coupling = 0;
+    for (ContactLayout& l : layout) {
+      const uint32_t numRows = l.row, numPoints = l.point;
+      l = {row, point, coupling, numRows};
+      row += numRows;
+      point += numPoints;
+      coupling += numRows > 0 ? 1 : 0;
+    }
+    s.rows.resize(row);  // each contact writes its rows' defaults (RowMode::FILL)
+    s.pointRows.resize(point);
+    s.couplings.resize(coupling);
+    for (int t = 0; t < threads; ++t) s.rowBuildAnchors[t].clear();
+    runTeam(threads, [&](int t, int n) {
+      const auto [b, e] = half(t, n);
+      RowCursor cur;  // on this thread's stack: the tallies are written per point (no shared cache line)
+      cur.anchors = &s.rowBuildAnchors[t];
+      for (uint32_t ci = b; ci < e; ++ci) {
+        const ContactLayout& l = layout[ci];
+        if (l.count == 0) continue;
+        cur.row = l.row;
+        cur.point = l.point;
+        cur.coupling = l.coupling;
+        contactRows<RowMode::FILL>(s, ci, k, cur);
+      }
+      tally[t] = cur;
+    });
+    auto& active = s.frictionAnchors.active;
+    for (int t = 0; t < threads; ++t)
+      active.insert(active.end(), s.rowBuildAnchors[t].begin(), s.rowBuildAnchors[t].end());
+  }
+  size_t numPoints = 0, numWarm = 0, numSolvedContacts = 0;
+  bool nonIterative = false;
+  for (const RowCursor& c : tally) {
+    numPoints += c.numPoints;
+    numWarm += c.numWarm;
+    numSolvedContacts += c.numSolved;
+    nonIterative = nonIterative || c.nonIterative;
   }
   s.nonIterativeRows = nonIterative;
 

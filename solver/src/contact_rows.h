@@ -46,6 +46,12 @@ struct PointRows {
   Vec3 twistArm = Vec3::Zero();
 };
 
+/// Where the parallel row build puts one contact's rows (contact_rows.cpp): its first row, point and coupling,
+/// and its row count (0: not solved).
+struct ContactLayout {
+  uint32_t row, point, coupling, count;
+};
+
 /// The row range and solver bodies of one solved contact or constraint (the couplings of the shock order).
 struct CouplingRange {
   int32_t ia, ib;
@@ -112,10 +118,12 @@ class WarmStartCache {
   /// search. Any cursor inside the entries gives pairRange's range (the entries before it are below the pair, or
   /// the search falls back); one left past the end by a commit of fewer entries is clamped. Start each pass with
   /// resetCursor(), so that it walks from the first entry.
-  std::pair<const Entry*, const Entry*> pairRangeAscending(uint64_t pair) {
+  std::pair<const Entry*, const Entry*> pairRangeAscending(uint64_t pair) { return pairRangeAscending(pair, cursor_); }
+  /// pairRangeAscending with the caller's cursor (one per thread of the parallel row build; start it at 0).
+  std::pair<const Entry*, const Entry*> pairRangeAscending(uint64_t pair, size_t& cursor) const {
     const Entry* base = current_.data();
     const Entry* last = base + current_.size();
-    const Entry* it = base + std::min(cursor_, current_.size());
+    const Entry* it = base + std::min(cursor, current_.size());
     if (it != base && it[-1].pair >= pair) return pairRange(pair);  // behind the cursor
     // Forward: a few entries linearly (the next pair's are usually next), then a binary search of the rest.
     constexpr int kLinear = 8;
@@ -130,7 +138,7 @@ class WarmStartCache {
     }
     const Entry* end = it;
     while (end != last && end->pair == pair) ++end;
-    cursor_ = size_t(end - base);
+    cursor = size_t(end - base);
     return {it, end};
   }
   void resetCursor() { cursor_ = 0; }

@@ -46,7 +46,7 @@ Real normalSum(const std::vector<ConstraintRow>& rows, const ConstraintRow& f) {
 
 void anchorManifoldFriction(SimulationState& s, uint64_t pair, int ia, int ib, const Vec3& centre,
                             const Vec3& normal, const Vec3& mt1, const Vec3& mt2, Real rEff, int32_t t1,
-                            int32_t twist, Real dampingTime) {
+                            int32_t twist, Real dampingTime, std::vector<FrictionAnchorCache::Active>& active) {
   const Frame A = frameOf(s, ia), B = frameOf(s, ib);
   FrictionAnchorCache::Active act{};
   act.t1 = t1;
@@ -80,7 +80,7 @@ void anchorManifoldFriction(SimulationState& s, uint64_t pair, int ia, int ib, c
     act.anchor.dirA = A.q.conjugate() * mt1;
     act.anchor.dirB = B.q.conjugate() * mt1;
   }
-  s.frictionAnchors.active.push_back(act);
+  active.push_back(act);
 }
 
 void storeFrictionAnchors(SimulationState& s) {

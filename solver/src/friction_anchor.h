@@ -101,10 +101,11 @@ inline constexpr Real kAnchorReach = 0.05;
 /// Row-build hook (contact_rows.cpp, manifold friction): adds the anchor's position term to the rows
 /// [t1, t1 + 1] (tangents mt1, mt2) and twist (about `normal`) of the manifold of `pair` centred at `centre`, and
 /// records the anchor for storeFrictionAnchors. A manifold without a kept anchor gets a new one at `centre`
-/// (rows unchanged). dampingTime is the contact law's (it sets the gain a, spook.h).
+/// (rows unchanged). dampingTime is the contact law's (it sets the gain a, spook.h). The record goes to `active`
+/// (FrictionAnchorCache::active, or a thread's list of the parallel row build, appended to it in contact order).
 void anchorManifoldFriction(SimulationState& s, uint64_t pair, int ia, int ib, const Vec3& centre,
                             const Vec3& normal, const Vec3& mt1, const Vec3& mt2, Real rEff, int32_t t1,
-                            int32_t twist, Real dampingTime);
+                            int32_t twist, Real dampingTime, std::vector<FrictionAnchorCache::Active>& active);
 
 /// Store hook (store_results.cpp): keeps the anchors of manifolds whose friction stayed inside its bound.
 void storeFrictionAnchors(SimulationState& s);

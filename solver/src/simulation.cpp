@@ -304,6 +304,7 @@ void Simulation::stepForward() {
   timed([&] { solve(s); });
   timed([&] { integrateMotion(s); });
   timed([&] { storeResults(s); });
+  endPartitionedWork(s);  // its few nanoseconds count to the next stage
   timedUnlessIdle(s.ranges.empty(), [&] { projectPositions(s); });
   timed([&] { checkFinite(s); });
   s.time += s.h;

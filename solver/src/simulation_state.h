@@ -6,6 +6,7 @@
 // from step to step (cleared, never reallocated once large enough).
 #pragma once
 
+#include <chrono>
 #include <unordered_set>
 #include <utility>
 #include <vector>
@@ -98,6 +99,10 @@ struct SimulationState {
   PgsPartition partition;
   bool partitionReady = false;  // the partition was computed for this step's rows (iterative paths only)
   SweepThreadChoice sweepThreads;  // the partitioned work's thread count by measurement (sweep_threads.h)
+  // The span of the step's partitioned work (step_stages.h beginPartitionedWork): its start, whether it was
+  // started (adaptive count) and whether this step's sweeps were partitioned, so that its time counts.
+  std::chrono::steady_clock::time_point partitionSpanStart{};
+  bool partitionSpanStarted = false, partitionSpanTimed = false;
   // Warm-start source (issue 18, solve_stage.cpp rigidShock): per contact row in the rigid shock pass, the
   // sweeps' impulse (plus, for a single support's normal rows, an even share of the load the pass added); NaN for
   // other rows; empty when no shock pass ran. storeResults caches these instead of the solved impulses.
@@ -111,6 +116,10 @@ struct SimulationState {
   // ---- issue 18 (friction anchors, friction_anchor.h): manifold anchors kept across steps and this step's
   // anchored manifolds (Solver::setUseFrictionAnchors) ----
   FrictionAnchorCache frictionAnchors;
+  // ---- issue 18 (two-thread scaling): the parallel contact row build's layout and per-thread anchor lists
+  // (contact_rows.cpp), kept across steps ----
+  std::vector<ContactLayout> contactLayout;
+  std::vector<FrictionAnchorCache::Active> rowBuildAnchors[PgsPartition::kRegions];
 
   // ---- position projection: its own direct solver, so each keeps its cached symbolic analysis ---------------
   DirectSolver projector;

@@ -290,15 +290,10 @@ void iterativePath(SimulationState& s, bool interleaved) {
     PgsSolver::colour(s.rows, s.sb, s.colouring);
   }
   SolverStats& st = s.solverStats();
-  // The partitioned work's thread count (sweep_threads.h): every available thread, or by measurement.
-  using Clock = std::chrono::steady_clock;
-  const bool timed = s.partitionReady && s.solver.getUseAdaptiveSweepThreads();
-  if (s.partitionReady) {
-    const int available = std::min(PgsPartition::kRegions, scree::getNumThreads());
-    s.partition.maxThreads = timed ? s.sweepThreads.begin(available) : available;
-    st.numSweepThreads = s.partition.maxThreads;
-  }
-  const Clock::time_point start = timed ? Clock::now() : Clock::time_point{};
+  // The partitioned work's thread count was chosen at the row build (beginPartitionedWork); the step times its
+  // span from there to the end of the store (endPartitionedWork).
+  s.partitionSpanTimed = s.partitionReady && s.partitionSpanStarted;
+  if (s.partitionReady) st.numSweepThreads = s.partition.maxThreads;
   const int iterations = s.solver.getNumIterations();
   const bool particles = hasParticleUnits(s);
   st.numIterativeRows = s.rows.size();
@@ -318,10 +313,27 @@ void iterativePath(SimulationState& s, bool interleaved) {
   st.lastResidual = residual;
   st.numIterations = size_t(iterations);
   if (!s.rows.empty()) rigidShock(s, false);
-  if (timed) s.sweepThreads.end(std::chrono::duration<double>(Clock::now() - start).count());
 }
 
 }  // namespace
+
+void beginPartitionedWork(SimulationState& s) {
+  s.partitionSpanStarted = s.partitionSpanTimed = false;
+  if (!s.solver.getUsePartitionedSweeps()) return;
+  const int available = std::min(PgsPartition::kRegions, scree::getNumThreads());
+  const bool adaptive = s.solver.getUseAdaptiveSweepThreads();
+  s.partition.maxThreads = adaptive ? s.sweepThreads.begin(available) : available;
+  if (adaptive && available >= 2) {
+    s.partitionSpanStart = std::chrono::steady_clock::now();
+    s.partitionSpanStarted = true;
+  }
+}
+
+void endPartitionedWork(SimulationState& s) {
+  if (!s.partitionSpanTimed) return;
+  s.sweepThreads.end(std::chrono::duration<double>(std::chrono::steady_clock::now() - s.partitionSpanStart).count());
+  s.partitionSpanTimed = s.partitionSpanStarted = false;
+}
 
 void solve(SimulationState& s) {
   SolverStats& st = s.solverStats();

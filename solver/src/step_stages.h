@@ -41,6 +41,12 @@ void buildContactRows(SimulationState& s);
 void buildConstraintRows(SimulationState& s);
 void buildParticleRows(SimulationState& s);
 void solve(SimulationState& s);
+/// The partitioned work of a step (Solver::setUsePartitionedSweeps; sweep_threads.h) runs from the contact row
+/// build to the store: beginPartitionedWork (called by buildContactRows) picks its thread count for the step and,
+/// with the adaptive count, starts its clock; endPartitionedWork (after storeResults) hands the span's wall time to
+/// the choice when the step's sweeps were partitioned. solve_stage.cpp.
+void beginPartitionedWork(SimulationState& s);
+void endPartitionedWork(SimulationState& s);
 void integrateMotion(SimulationState& s);
 void storeResults(SimulationState& s);
 void projectPositions(SimulationState& s);

@@ -7,9 +7,13 @@
 // count is free to change from step to step. Whether a second thread pays depends on the host more than on the
 // scene: on the 2-core KVM guest this was written on, a cache line took either about 150 ns or about 550 ns to
 // cross between the cores, in states that lasted hours; in the slow state pyramid20's partitioned solve took
-// 0.65 ms per step on two threads against 0.43 ms on one; in the fast state two threads took about 1.1x less. A user who
-// asks for two threads should never get a slower simulation for it. So the solve stage times the
-// thread-dependent part of its step (the partitioned sweeps and shock pass) and this class picks the count:
+// 0.65 ms per step on two threads against 0.43 ms on one; in the fast state two threads took about 1.1x less. A
+// user who asks for two threads should never get a slower simulation for it. So the step times the span of its
+// partitioned work and this class picks the count. The span runs from the contact row build (which runs on the
+// same count) to the end of the store (step_stages.h beginPartitionedWork, endPartitionedWork): the serial stages
+// in between, prepare, the records and the store, also pay for the data the second thread wrote (pyramid20 in
+// the slow state: the store 0.018 ms on one thread, 0.043 ms after two-thread sweeps), so timing only the sweeps
+// and the shock pass, as before stop 44, showed a second thread as better than it was.
 //  - probe: kProbeSteps steps on every available thread (at most one per region), then kProbeSteps on one; the
 //    first kSettleSteps of each block are not counted (the step that moves the work between the cores pays for
 //    pulling its data over, as does a scene's first step for its allocations);

@@ -40,6 +40,9 @@ struct SolverStats {
   /// Threads the partitioned sweeps and shock pass ran on this step (Solver::setUsePartitionedSweeps,
   /// setUseAdaptiveSweepThreads); 1 on every other path.
   int numSweepThreads = 1;
+  /// Threads the contact rows were built on this step: with partitioned sweeps and at least 128 contacts the
+  /// sweeps' count, else 1. The rows are the same bits on any count.
+  int numRowBuildThreads = 1;
   /// Coarse correction (Solver::setUseCoarseCorrection): the largest number of coarse unknowns of this step's
   /// corrections, the re-factorisations for groups held at their bounds, and the corrections that needed a fresh
   /// symbolic analysis of the coarse operator (0 while its sparsity pattern holds); all 0 when off.
@@ -160,19 +163,20 @@ class Solver {
   /// "Partitioned sweeps"): the dynamic bodies are cut by a plane into two regions of about equal work; the
   /// contacts and joints inside each region are swept by their own thread, those across the cut by one thread
   /// between barriers (one barrier per sweep instead of one per colour). The shock pass runs the supports of
-  /// each region on their own thread in the same dependency order (its result equals the serial pass's).
-  /// Results are bit-identical for any thread count (setNumThreads). The sweep order differs from the default
-  /// serial order (each region's contacts, then those across the cut), so trajectories differ from the
-  /// default's. Takes precedence over setUseColouredSweeps when both are on.
+  /// each region on their own thread in the same dependency order (its result equals the serial pass's). With 128
+  /// contacts or more the contact rows are built on the same threads too, each a fixed half of the contacts
+  /// (SolverStats::numRowBuildThreads). Results are bit-identical for any thread count (setNumThreads). The
+  /// sweep order differs from the default serial order (each region's contacts, then those across the cut), so
+  /// trajectories differ from the default's. Takes precedence over setUseColouredSweeps when both are on.
   void setUsePartitionedSweeps(bool on) { partitionedSweeps_ = on; }
   bool getUsePartitionedSweeps() const { return partitionedSweeps_; }
   /// The partitioned sweeps' thread count by measurement (default on): whether a second thread pays depends on
   /// the host (how fast a cache line crosses between its cores) more than on the scene, and the results are the
-  /// same bits on any count. So the solve stage times its partitioned sweeps and shock pass on every available
-  /// thread (scree::setNumThreads, at most one per region) and on one, 8 steps each (the first 2 not counted),
-  /// and keeps the count with the lower median (one on a tie) for 120 steps, then measures again; each
-  /// measurement that confirms the choice doubles the hold, up to 7680 steps. Off: always every available
-  /// thread. SolverStats::numSweepThreads reports the count of the last step. docs/solver-internals.md
+  /// same bits on any count. So the step times its partitioned work, from the contact row build to the result
+  /// store, on every available thread (scree::setNumThreads, at most one per region) and on one, 8 steps each
+  /// (the first 2 not counted), and keeps the count with the lower median (one on a tie) for 120 steps, then
+  /// measures again; each measurement that confirms the choice doubles the hold, up to 7680 steps. Off: always
+  /// every available thread. SolverStats::numSweepThreads reports the count of the last step. docs/solver-internals.md
   /// "Partitioned sweeps: the thread count by measurement".
   void setUseAdaptiveSweepThreads(bool on) { adaptiveSweepThreads_ = on; }
   bool getUseAdaptiveSweepThreads() const { return adaptiveSweepThreads_; }
