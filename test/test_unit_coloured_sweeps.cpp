@@ -218,13 +218,14 @@ TEST_CASE("contact rows built on two threads: the serial build's bits for every 
   // The row build of the partitioned path (contact_rows.cpp) cuts the contacts in halves, counts each half's rows
   // on its thread, places them, then fills them. Its count must agree with the fill for every row layout, not
   // only pyramid20's manifold friction. A 12-row pyramid (78 boxes) beside a row of 48 spheres on the ground, in
-  // three variants: the default (box manifolds with manifold friction and single sphere points), rolling
-  // resistance (per-point friction and rolling rows), and the box friction model (per-point box friction). 90
-  // steps: the spheres land at step 20-25 and the contacts' warm starts and anchors are in use.
+  // four variants: the default (box manifolds with manifold friction and single sphere points), rolling
+  // resistance (per-point friction and rolling rows), the box friction model (per-point box friction), and
+  // friction anchors (Solver::setUseFrictionAnchors: each thread lists its anchored manifolds, joined in contact
+  // order). 90 steps: the spheres land at step 20-25 and the contacts' warm starts and anchors are in use.
   setNumThreads(2);
   const bool twoThreads = getNumThreads() == 2;
   setNumThreads(1);
-  for (int variant = 0; variant < 3; ++variant) {
+  for (int variant = 0; variant < 4; ++variant) {
     CAPTURE(variant);
     auto run = [variant](int threads, int& rowThreads, size_t& contacts) {
       setNumThreads(threads);
@@ -240,6 +241,7 @@ TEST_CASE("contact rows built on two threads: the serial build's bits for every 
       }
       if (variant == 1) s.contactMaterial->setRollingResistanceCoefficient(0.05);
       if (variant == 2) s.contactMaterial->setFrictionModel(std::make_shared<BoxFrictionModel>());
+      if (variant == 3) s.sim->getSolver().setUseFrictionAnchors(true);
       s.sim->getSolver().setUsePartitionedSweeps(true);
       s.sim->getSolver().setUseAdaptiveSweepThreads(false);
       rowThreads = threads;
