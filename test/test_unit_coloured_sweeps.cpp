@@ -221,7 +221,8 @@ TEST_CASE("contact rows built on two threads: the serial build's bits for every 
   // four variants: the default (box manifolds with manifold friction and single sphere points), rolling
   // resistance (per-point friction and rolling rows), the box friction model (per-point box friction), and
   // friction anchors (Solver::setUseFrictionAnchors: each thread lists its anchored manifolds, joined in contact
-  // order). 90 steps: the spheres land at step 20-25 and the contacts' warm starts and anchors are in use.
+  // order). 90 steps: the spheres fall 1.7 m and land at about step 35 (0.59 s at 60 Hz), and for the rest the
+  // contacts' warm starts and anchors are in use.
   setNumThreads(2);
   const bool twoThreads = getNumThreads() == 2;
   setNumThreads(1);
