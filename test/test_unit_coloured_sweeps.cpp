@@ -10,10 +10,12 @@
 #include <cmath>
 #include <chrono>
 #include <cstring>
+#include <limits>
 #include <set>
 #include <thread>
 #include <vector>
 
+#include "body_state.h"
 #include "scenes/scenes.h"
 #include "scree/core/parallel.h"
 #include "scree/solver/pgs.h"
@@ -25,16 +27,9 @@ using namespace scree::detail;
 TEST_SUITE("coloured sweeps") {
 
 namespace {
-// Every body's position, velocity and angular velocity, and the top box's rotation: the state compared bit for bit.
-std::vector<Real> pyramidState(const scenes::PyramidScene& s) {
-  std::vector<Real> state;
-  for (const RigidBodyRef& b : s.sim->getRigidBodies())
-    for (const Vec3& v : {b->getPosition(), b->getVelocity(), b->getAngularVelocity()})
-      state.insert(state.end(), v.data(), v.data() + 3);
-  const Quat q = s.top->getRotation();
-  state.insert(state.end(), {q.w(), q.x(), q.y(), q.z()});
-  return state;
-}
+// The state compared bit for bit (test/body_state.h): every body's position, velocity, angular velocity and
+// rotation.
+std::vector<Real> pyramidState(const scenes::PyramidScene& s) { return scree::test::bodyState(*s.sim); }
 }  // namespace
 
 TEST_CASE("colouring: no colour holds two units that share a dynamic body; static bodies are shared freely") {
@@ -252,14 +247,7 @@ TEST_CASE("contact rows built on two threads: the serial build's bits for every 
       }
       contacts = s.sim->getContacts().size();
       setNumThreads(1);
-      std::vector<Real> state;
-      for (const RigidBodyRef& b : s.sim->getRigidBodies()) {
-        for (const Vec3& v : {b->getPosition(), b->getVelocity(), b->getAngularVelocity()})
-          state.insert(state.end(), v.data(), v.data() + 3);
-        const Quat q = b->getRotation();
-        state.insert(state.end(), {q.w(), q.x(), q.y(), q.z()});
-      }
-      return state;
+      return scree::test::bodyState(*s.sim);
     };
     int rowsOne = 0, rowsTwo = 0;
     size_t contactsOne = 0, contactsTwo = 0;
@@ -331,6 +319,28 @@ TEST_CASE("sweep thread choice: probe schedule, the faster count wins, ties go t
     CHECK(c.hold() == C::kFirstHold);
     holdFor(c, C::kFirstHold, 2);
   }
+  SUBCASE("steps that asked for the team and did not get it count as infinitely slow") {
+    // endPartitionedWork passes +infinity for them (another Simulation held the team). Two of the six timed
+    // steps without the team: the median is still the other steps', and two threads, faster, win. Three of six:
+    // the median is infinite and one thread wins, though every step that got the team was faster.
+    for (const int busy : {2, 3}) {
+      CAPTURE(busy);
+      C c;
+      for (int k = 0; k < P; ++k) {
+        REQUIRE(c.begin(2) == 2);
+        const int timed = k - C::kSettleSteps;
+        c.end(timed >= 0 && timed < busy ? std::numeric_limits<double>::infinity() : 0.3e-3);
+      }
+      for (int k = 0; k < P; ++k) {
+        REQUIRE(c.begin(2) == 1);
+        c.end(0.6e-3);
+      }
+      CHECK(c.chosen() == (busy == 2 ? 2 : 1));
+      CHECK(c.medianOne() == 0.6e-3);
+      if (busy == 2) CHECK(c.medianMany() == 0.3e-3);
+      else CHECK(std::isinf(c.medianMany()));
+    }
+  }
   SUBCASE("a tie goes to one thread") {
     C c;
     probe(c, 0.5e-3, 0.5e-3, 0.0);
@@ -390,6 +400,47 @@ TEST_CASE("partitioned sweeps with the adaptive thread count: the probe schedule
   scenes::PyramidScene d = scenes::buildPyramid20();
   d.step();
   CHECK(d.sim->getSolver().getStats().numSweepThreads == 1);
+}
+
+TEST_CASE("partitioned work that finds the team busy: the stats report the one thread it ran on, the bits hold") {
+  // A step taken inside a team job finds the team in use, as one Simulation's step does while another's holds
+  // the team (scree/core/parallel.h runTeamJob): the row build's, the sweeps' and the shock pass's jobs then run
+  // on the calling thread alone. SolverStats must report the threads that ran, not those asked for, and the
+  // state must stay the one-thread run's. pyramid20 (about 400 contacts: rows, sweeps and shock pass all ask
+  // for two threads), the count fixed at two; steps 0-9 inside a job, 10-19 outside it, 20-29 inside again.
+  setNumThreads(2);
+  const bool twoThreads = getNumThreads() == 2;
+  setNumThreads(1);
+  if (!twoThreads) {
+    WARN_MESSAGE(false, "built without OpenMP: no team to find busy");
+    return;
+  }
+  constexpr int steps = 30;
+  const auto [one, m1] = runPartitioned(1, true, steps);
+  setNumThreads(2);
+  scenes::PyramidScene s = scenes::buildPyramid20();
+  s.sim->getSolver().setUsePartitionedSweeps(true);
+  s.sim->getSolver().setUseAdaptiveSweepThreads(false);
+  std::vector<int> rowThreads, sweepThreads;
+  for (int i = 0; i < steps; ++i) {
+    const bool inside = i < 10 || i >= 20;
+    if (inside) runTeam(2, [&](int t, int) {
+        if (t == 0) s.step();
+      });
+    else s.step();
+    rowThreads.push_back(s.sim->getSolver().getStats().numRowBuildThreads);
+    sweepThreads.push_back(s.sim->getSolver().getStats().numSweepThreads);
+  }
+  setNumThreads(1);
+  for (int i = 0; i < steps; ++i) {
+    CAPTURE(i);
+    const int expected = i < 10 || i >= 20 ? 1 : 2;
+    CHECK(rowThreads[size_t(i)] == expected);
+    CHECK(sweepThreads[size_t(i)] == expected);
+  }
+  const std::vector<Real> mixed = pyramidState(s);
+  REQUIRE(one.size() == mixed.size());
+  CHECK(std::memcmp(one.data(), mixed.data(), one.size() * sizeof(Real)) == 0);
 }
 
 // ---- issue 18 (sweep scheduling): the persistent team the partitioned stages run on (scree/core/parallel.h) ----

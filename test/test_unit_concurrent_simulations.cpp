@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "body_state.h"
 #include "scenes/scenes.h"
 #include "scree/core/parallel.h"
 #include "scree/model/suction_gripper.h"
@@ -25,17 +26,8 @@ using namespace scree;
 TEST_SUITE("concurrent simulations") {
 
 namespace {
-// Every body's position, rotation, velocity and angular velocity: the state compared bit for bit.
-std::vector<Real> bodyState(const Simulation& sim) {
-  std::vector<Real> state;
-  for (const RigidBodyRef& b : sim.getRigidBodies()) {
-    for (const Vec3& v : {b->getPosition(), b->getVelocity(), b->getAngularVelocity()})
-      state.insert(state.end(), v.data(), v.data() + 3);
-    const Quat q = b->getRotation();
-    state.insert(state.end(), {q.w(), q.x(), q.y(), q.z()});
-  }
-  return state;
-}
+using test::bodyState;  // the state compared bit for bit (test/body_state.h)
+using test::sameBits;
 
 struct Job {
   std::function<scenes::PyramidScene()> build;
@@ -54,9 +46,6 @@ std::vector<Real> runJob(const Job& job, std::latch* start = nullptr) {
   return bodyState(*s.sim);
 }
 
-bool sameBits(const std::vector<Real>& a, const std::vector<Real>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Real)) == 0;
-}
 }  // namespace
 
 TEST_CASE("two Simulations stepped at once on two threads give the bits of the serial run") {

@@ -395,7 +395,7 @@ void buildContactRows(SimulationState& s) {
                            solver.getUseManifoldFriction()};
   const uint32_t numContacts = uint32_t(s.contacts.size());
   const int threads = rowBuildThreads(s);
-  s.solverStats().numRowBuildThreads = threads;
+  int ran = threads;  // the fewest threads a job of the build got (one if another Simulation held the team)
   RowCursor tally[PgsPartition::kRegions];
   if (threads == 1) {
     s.rows.clear();
@@ -415,6 +415,7 @@ void buildContactRows(SimulationState& s) {
                                            uint32_t(uint64_t(numContacts) * uint64_t(t + 1) / uint64_t(n))};
     };
     runTeam(threads, [&](int t, int n) {
+      if (t == 0) ran = std::min(ran, n);
       const auto [b, e] = half(t, n);
       RowCursor scratch;
       for (uint32_t ci = b; ci < e; ++ci) {
@@ -435,6 +436,7 @@ void buildContactRows(SimulationState& s) {
     s.couplings.resize(coupling);
     for (int t = 0; t < threads; ++t) s.rowBuildAnchors[t].clear();
     runTeam(threads, [&](int t, int n) {
+      if (t == 0) ran = std::min(ran, n);
       const auto [b, e] = half(t, n);
       RowCursor cur;  // on this thread's stack: the tallies are written per point (no shared cache line)
       cur.anchors = &s.rowBuildAnchors[t];
@@ -452,6 +454,8 @@ void buildContactRows(SimulationState& s) {
     for (int t = 0; t < threads; ++t)
       active.insert(active.end(), s.rowBuildAnchors[t].begin(), s.rowBuildAnchors[t].end());
   }
+  s.solverStats().numRowBuildThreads = ran;
+  s.rowBuildTeamBusy = ran < threads;
   size_t numPoints = 0, numWarm = 0, numSolvedContacts = 0;
   bool nonIterative = false;
   for (const RowCursor& c : tally) {

@@ -1721,6 +1721,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   Real lastSweep[R] = {};
   TeamBarrier barrier(threads);
   runTeam(threads, [&](int t, int nt) {
+    if (nt < threads) p.teamBusy = true;  // only the calling thread runs then (nt == 1)
     Real local = 0;
     auto regions = [&](bool forward) {
       for (int g = 0; g < R; ++g)
@@ -1810,6 +1811,7 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
   runTeam(threads, [&](int t, int nt) {
     if (nt < R) {
       // Fewer threads than lists (the team was busy): the serial pass (the same bits).
+      p.teamBusy = true;  // only the calling thread runs then (nt == 1)
       if (t == 0) shockPass(rows, bodies, ranges, maxSweeps, blocks);
     } else if (t < R) {
       const int other = 1 - t;

@@ -99,10 +99,13 @@ struct SimulationState {
   PgsPartition partition;
   bool partitionReady = false;  // the partition was computed for this step's rows (iterative paths only)
   SweepThreadChoice sweepThreads;  // the partitioned work's thread count by measurement (sweep_threads.h)
-  // The span of the step's partitioned work (step_stages.h beginPartitionedWork): its start, whether it was
-  // started (adaptive count) and whether this step's sweeps were partitioned, so that its time counts.
+  // The span of the step's partitioned work (step_stages.h beginPartitionedWork): its start, and whether it was
+  // started (adaptive count). It counts when this step's sweeps were partitioned too (partitionReady).
   std::chrono::steady_clock::time_point partitionSpanStart{};
-  bool partitionSpanStarted = false, partitionSpanTimed = false;
+  bool partitionSpanStarted = false;
+  // Some team job of this step's row build got fewer threads than it asked for (another Simulation held the
+  // team); the sweeps' and shock pass's jobs report theirs in partition.teamBusy.
+  bool rowBuildTeamBusy = false;
   // Warm-start source (issue 18, solve_stage.cpp rigidShock): per contact row in the rigid shock pass, the
   // sweeps' impulse (plus, for a single support's normal rows, an even share of the load the pass added); NaN for
   // other rows; empty when no shock pass ran. storeResults caches these instead of the solved impulses.

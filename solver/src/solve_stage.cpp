@@ -292,8 +292,6 @@ void iterativePath(SimulationState& s, bool interleaved) {
   SolverStats& st = s.solverStats();
   // The partitioned work's thread count was chosen at the row build (beginPartitionedWork); the step times its
   // span from there to the end of the store (endPartitionedWork).
-  s.partitionSpanTimed = s.partitionReady && s.partitionSpanStarted;
-  if (s.partitionReady) st.numSweepThreads = s.partition.maxThreads;
   const int iterations = s.solver.getNumIterations();
   const bool particles = hasParticleUnits(s);
   st.numIterativeRows = s.rows.size();
@@ -313,12 +311,15 @@ void iterativePath(SimulationState& s, bool interleaved) {
   st.lastResidual = residual;
   st.numIterations = size_t(iterations);
   if (!s.rows.empty()) rigidShock(s, false);
+  // The count the sweeps and the shock pass ran on: the one asked for, or one if a job found the team busy.
+  if (s.partitionReady) st.numSweepThreads = s.partition.teamBusy ? 1 : s.partition.maxThreads;
 }
 
 }  // namespace
 
 void beginPartitionedWork(SimulationState& s) {
-  s.partitionSpanStarted = s.partitionSpanTimed = false;
+  s.partitionSpanStarted = false;
+  s.rowBuildTeamBusy = s.partition.teamBusy = false;
   if (!s.solver.getUsePartitionedSweeps()) return;
   const int available = std::min(PgsPartition::kRegions, scree::getNumThreads());
   const bool adaptive = s.solver.getUseAdaptiveSweepThreads();
@@ -330,9 +331,14 @@ void beginPartitionedWork(SimulationState& s) {
 }
 
 void endPartitionedWork(SimulationState& s) {
-  if (!s.partitionSpanTimed) return;
-  s.sweepThreads.end(std::chrono::duration<double>(std::chrono::steady_clock::now() - s.partitionSpanStart).count());
-  s.partitionSpanTimed = s.partitionSpanStarted = false;
+  // Timed only when this step's sweeps were partitioned (partitionReady holds from the solve to the next one).
+  if (!s.partitionSpanStarted || !s.partitionReady) return;
+  s.partitionSpanStarted = false;
+  // A step that asked the team for more than one thread and did not get it ran on one: it is not a sample of
+  // the count asked for (SweepThreadChoice::end).
+  const bool busy = s.rowBuildTeamBusy || s.partition.teamBusy;
+  s.sweepThreads.end(busy ? std::numeric_limits<double>::infinity()
+                          : std::chrono::duration<double>(std::chrono::steady_clock::now() - s.partitionSpanStart).count());
 }
 
 void solve(SimulationState& s) {

@@ -52,7 +52,9 @@ class SweepThreadChoice {
     return chosen_;
   }
 
-  /// Wall time (s) of this step's partitioned work, run on the count begin() returned.
+  /// Wall time (s) of this step's partitioned work, run on the count begin() returned. +infinity for a step that
+  /// asked the team for more threads and ran on one (another Simulation held the team): a probe of the many
+  /// then picks one thread when at least half of its timed steps did not get the team.
   void end(double seconds) {
     if (available_ < 2) return;
     switch (phase_) {

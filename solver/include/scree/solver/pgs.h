@@ -199,6 +199,10 @@ struct PgsPartition {
   /// Cap on the threads of the partitioned sweeps and shock pass (0: scree::getNumThreads()); at most one thread
   /// per region either way. The solve stage sets it from its measurements (Solver::setUseAdaptiveSweepThreads).
   int maxThreads = 0;
+  /// Output: set when a sweep or shock job asked the team for two threads and ran on one, because another
+  /// Simulation held the team (scree/core/parallel.h runTeamJob; the bits are the same). Never cleared here: the
+  /// caller clears it before the step's partitioned work.
+  bool teamBusy = false;
 };
 
 class PgsSolver {
