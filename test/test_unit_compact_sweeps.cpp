@@ -9,8 +9,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
+#include "scree/core/parallel.h"
 #include "scree/solver/pgs.h"
 
 using namespace scree;
@@ -375,6 +377,92 @@ TEST_CASE("normal rows prepared on first use give the prepared rows' sweeps, fal
     PgsSolver::iterate(rowsP, bodiesP, 10, &blocksP, cP);
     compareRuns(rowsD, rowsP, bodiesD, bodiesP);
   }
+}
+
+TEST_CASE("prepare on rows grouped by region: the serial prepare's bits, the regions on two threads") {
+  // PgsSolver::prepare with PrepareGroups (pgs.cpp; the grouped contact row build lays the rows out so):
+  // region 0's rows, region 1's, then the rest (boundary contacts, joints), the regions on two threads at once
+  // and the rest after them. Every body's warm-start sum must keep the row order of the serial prepare on the
+  // same rows, so bodies, rows and block operators must come out bit for bit as the serial prepare's. Scene
+  // (as in the partitioned-sweeps test above): boxes 0, 1, 6 in region 0, boxes 2, 3, 5 in region 1, a static
+  // ground (body 4) that both regions' rows touch, a boundary manifold between boxes 1 and 2 and a joint-like
+  // row between boxes 0 and 3 in the rest, so that boxes 0, 1, 2 and 3 get impulses from a region's rows and
+  // from the rest. Every row carries a different warm-start impulse (a sum's order shows in its last bits).
+  std::vector<SolverBodyState> bodies(7);
+  const Vec3 c[7] = {Vec3(-1.5, 0, 0.5), Vec3(-0.5, 0, 0.5), Vec3(0.5, 0, 0.5), Vec3(1.5, 0, 0.5),
+                     Vec3::Zero(),       Vec3(1.5, 0, 1.5),  Vec3(-1.5, 0, 1.5)};
+  for (int i : {0, 1, 2, 3, 5, 6}) {
+    bodies[size_t(i)].invMass = 0.5 + 0.01 * i;
+    bodies[size_t(i)].invInertia = Mat3(Vec3(3.0, 2.0 + 0.1 * i, 2.5).asDiagonal());
+    bodies[size_t(i)].v = Vec3(0.01 * i, -0.02, -0.3);
+    bodies[size_t(i)].w = Vec3(0.1, -0.03 * i, 0.02);
+  }
+  std::vector<ConstraintRow> rows;
+  auto freeRow = [&](int a, int b) {
+    ConstraintRow r;
+    r.bodyA = a;
+    r.bodyB = b;
+    r.jLinA = Vec3(0.3, 1, 0).normalized();
+    r.jAngA = Vec3(0, 0.2, 1);
+    r.jLinB = -r.jLinA;
+    r.jAngB = Vec3(0.1, 0, -1);
+    r.e = 1e-4;
+    rows.push_back(r);
+  };
+  addManifold(rows, 0, 4, c[0], c[4], Vec3(-1.5, 0, 0), 0.5, 0.6);
+  addManifold(rows, 6, 0, c[6], c[0], Vec3(-1.5, 0, 1.0), 0.45, 0.5);
+  addManifold(rows, 1, 4, c[1], c[4], Vec3(-0.5, 0, 0), 0.5, 0.6);
+  freeRow(1, -1);
+  const uint32_t end0 = uint32_t(rows.size());
+  addManifold(rows, 3, 4, c[3], c[4], Vec3(1.5, 0, 0), 0.5, 0.6);
+  addManifold(rows, 5, 3, c[5], c[3], Vec3(1.5, 0, 1.0), 0.45, 0.4);
+  freeRow(2, 4);
+  addManifold(rows, 2, 4, c[2], c[4], Vec3(0.5, 0, 0), 0.5, 0.6);
+  const uint32_t end1 = uint32_t(rows.size());
+  addManifold(rows, 2, 1, c[2], c[1], Vec3(0, 0, 0.5), 0.3, 0.6);  // the boundary
+  freeRow(0, 3);                                                      // a joint's row across the regions
+  for (size_t i = 0; i < rows.size(); ++i) rows[i].lambda = 0.5 + 0.037 * Real(i);
+  setNumThreads(2);
+  const int threads = getNumThreads();
+  for (const bool defer : {true, false}) {
+    CAPTURE(defer);
+    std::vector<ConstraintRow> rowsS = rows, rowsG = rows;
+    std::vector<SolverBodyState> bodiesS = bodies, bodiesG = bodies;
+    PgsBlocks blocksS, blocksG;
+    PgsSolver::prepare(rowsS, bodiesS, &blocksS, defer);
+    PgsSolver::PrepareGroups groups;
+    groups.rowEnd[0] = end0;
+    groups.rowEnd[1] = end1;
+    groups.threads = threads;
+    bool busy = false;
+    groups.teamBusy = &busy;
+    PgsSolver::prepare(rowsG, bodiesG, &blocksG, defer, groups);
+    CHECK_FALSE(busy);
+    CHECK(blocksG.anyDeferred == blocksS.anyDeferred);
+    for (size_t b = 0; b < bodies.size(); ++b) {
+      CAPTURE(b);
+      CHECK(std::memcmp(bodiesS[b].v.data(), bodiesG[b].v.data(), sizeof(Vec3)) == 0);
+      CHECK(std::memcmp(bodiesS[b].w.data(), bodiesG[b].w.data(), sizeof(Vec3)) == 0);
+    }
+    CHECK(bodiesS[0].v != bodies[0].v);  // the warm start moved the bodies
+    for (size_t i = 0; i < rows.size(); ++i) {
+      CAPTURE(i);
+      const ConstraintRow &s = rowsS[i], &g = rowsG[i];
+      for (const auto& [a, b] : {std::pair{&s.mJLinA, &g.mJLinA}, {&s.mJAngA, &g.mJAngA}, {&s.mJLinB, &g.mJLinB},
+                                 {&s.mJAngB, &g.mJAngB}})
+        CHECK(std::memcmp(a->data(), b->data(), sizeof(Vec3)) == 0);
+      CHECK(std::memcmp(&s.diag, &g.diag, sizeof(Real)) == 0);
+      // A block's slot differs (each region numbers its own), its operators must not.
+      REQUIRE((s.blockSlot >= 0) == (g.blockSlot >= 0));
+      if (s.blockSlot < 0) continue;
+      const PgsBlocks::Block &bs = blocksS.blocks[size_t(s.blockSlot)], &bg = blocksG.blocks[size_t(g.blockSlot)];
+      CHECK(bs.rowsReady == bg.rowsReady);
+      CHECK(std::memcmp(bs.wAngA, bg.wAngA, sizeof(bs.wAngA)) == 0);
+      CHECK(std::memcmp(bs.wLinB, bg.wLinB, sizeof(bs.wLinB)) == 0);
+      CHECK(std::memcmp(bs.sInv[0], bg.sInv[0], sizeof(bs.sInv[0])) == 0);
+    }
+  }
+  setNumThreads(1);
 }
 
 }  // TEST_SUITE

@@ -371,14 +371,35 @@ std::pair<uint32_t, uint32_t> contactRows(SimulationState& s, uint32_t ci, const
   return {numRows, nActive};
 }
 
-/// Threads for the contact row build: the partitioned work's count for this step (beginPartitionedWork), one
-/// for few contacts. The build gives the same bits on any count.
-int rowBuildThreads(const SimulationState& s) {
+/// The grouped build (partitioned sweeps and at least 128 contacts, with a region map from an earlier step): the
+/// contacts are laid out by group, the regions' first, then the boundary's (PgsPartition), on any thread count.
+bool groupedBuild(const SimulationState& s) {
   // Not tuned: pyramid20's build takes about 0.3 us per contact, so below 128 contacts the half saved (under
   // 20 us) is not much more than the build's two hand-overs to the team (a few us each in the VMs measured).
   constexpr size_t kMinContacts = 128;
-  if (!s.solver.getUsePartitionedSweeps() || s.contacts.size() < kMinContacts) return 1;
+  return s.solver.getUsePartitionedSweeps() && s.contacts.size() >= kMinContacts &&
+         s.partition.bodyRegion.size() == s.sb.size();
+}
+
+/// Threads for the grouped build: the partitioned work's count for this step (beginPartitionedWork).
+int rowBuildThreads(const SimulationState& s) {
   return std::max(1, std::min({s.partition.maxThreads, PgsPartition::kRegions, scree::getNumThreads()}));
+}
+
+/// A contact's group by the last step's region map: region r when every movable body it touches lies in r,
+/// else (two regions, a body the map does not know as movable, or none) the boundary, kRegions.
+int contactGroup(const SimulationState& s, uint32_t ci) {
+  constexpr int kBoundary = PgsPartition::kRegions;
+  const GeometryContact& c = s.contacts[ci];
+  int group = -1;
+  for (int k = 0; k < 2; ++k) {
+    const int b = s.solverIndex(c.rigidBody(k));
+    if (b < 0 || !PgsPartition::movable(s.sb[size_t(b)])) continue;
+    const int r = s.partition.bodyRegion[size_t(b)];
+    if (r < 0 || (group >= 0 && group != r)) return kBoundary;
+    group = r;
+  }
+  return group < 0 ? kBoundary : group;
 }
 
 }  // namespace
@@ -394,65 +415,98 @@ void buildContactRows(SimulationState& s) {
                            solver.getUseManifoldNormalBlock(),
                            solver.getUseManifoldFriction()};
   const uint32_t numContacts = uint32_t(s.contacts.size());
-  const int threads = rowBuildThreads(s);
+  constexpr int G = PgsPartition::kRegions + 1;  // the regions' groups, then the boundary's
+  const bool grouped = groupedBuild(s);
+  const int threads = grouped ? rowBuildThreads(s) : 1;
   int ran = threads;  // the fewest threads a job of the build got (one if another Simulation held the team)
-  RowCursor tally[PgsPartition::kRegions];
-  if (threads == 1) {
+  RowCursor tally[G];
+  s.rowGroupsReady = grouped;
+  s.rowGroupThreads = threads;
+  if (!grouped) {
     s.rows.clear();
     s.pointRows.clear();
     s.couplings.clear();
     tally[0].anchors = &s.frictionAnchors.active;
     for (uint32_t ci = 0; ci < numContacts; ++ci) contactRows<RowMode::APPEND>(s, ci, k, tally[0]);
   } else {
-    // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "The contact rows on the team"): the
-    // contacts cut in fixed halves by index. Each thread counts its half's rows and points; one prefix sum on
-    // the calling thread places every contact; each thread then fills its half in place, with its own warm-start
-    // cursor and its own list of anchored manifolds (appended in half order, i.e. contact order).
+    // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "The contact rows by region"): the contacts
+    // laid out by group, by the last step's region map (the partition keeps its cut while the scene's units stay
+    // the same): region 0's contacts, region 1's, then the boundary's, each group in contact order. Region r's
+    // rows then touch no movable body of the other region, so that PgsSolver::prepare can run the two regions'
+    // rows on two threads and keep every body's warm-start sum in row order, and each region's rows are built
+    // on the thread that sweeps it. Each thread counts its groups' rows and points (thread 0 also the
+    // boundary's), one prefix sum places every contact, and each thread fills its groups in place, with a
+    // warm-start cursor and a list of anchored manifolds per group (joined in group order, i.e. row order). The
+    // layout is the same on any thread count, so are the bits.
+    for (auto& list : s.contactGroups) list.clear();
+    for (uint32_t ci = 0; ci < numContacts; ++ci) s.contactGroups[contactGroup(s, ci)].push_back(ci);
     auto& layout = s.contactLayout;
     layout.resize(numContacts);
-    auto half = [numContacts](int t, int n) {
-      return std::pair<uint32_t, uint32_t>{uint32_t(uint64_t(numContacts) * uint64_t(t) / uint64_t(n)),
-                                           uint32_t(uint64_t(numContacts) * uint64_t(t + 1) / uint64_t(n))};
-    };
-    runTeam(threads, [&](int t, int n) {
-      if (t == 0) ran = std::min(ran, n);
-      const auto [b, e] = half(t, n);
-      RowCursor scratch;
-      for (uint32_t ci = b; ci < e; ++ci) {
-        const auto [numRows, numPoints] = contactRows<RowMode::COUNT>(s, ci, k, scratch);
-        layout[ci] = {numRows, numPoints, 0, 0};
+    if (threads == 1) {
+      // One thread: appended group by group, the layout the two-thread build places (and the same bits).
+      s.rows.clear();
+      s.pointRows.clear();
+      s.couplings.clear();
+      tally[0].anchors = &s.frictionAnchors.active;
+      for (int g = 0; g < G; ++g) {
+        tally[0].warmCursor = 0;  // each group's contacts ascend
+        for (const uint32_t ci : s.contactGroups[g]) {
+          const uint32_t row = uint32_t(s.rows.size()), point = uint32_t(s.pointRows.size()),
+                         coupling = uint32_t(s.couplings.size());
+          const uint32_t numRows = contactRows<RowMode::APPEND>(s, ci, k, tally[0]).first;
+          layout[ci] = {row, point, coupling, numRows};
+        }
+        s.rowGroupEnd[g] = uint32_t(s.rows.size());
       }
-    });
-    uint32_t row = 0, point = 0, coupling = 0;
-    for (ContactLayout& l : layout) {
-      const uint32_t numRows = l.row, numPoints = l.point;
-      l = {row, point, coupling, numRows};
-      row += numRows;
-      point += numPoints;
-      coupling += numRows > 0 ? 1 : 0;
+    } else {
+      auto owner = [](int g, int n) { return g < PgsPartition::kRegions ? g % n : 0; };
+      runTeam(threads, [&](int t, int n) {
+        if (t == 0) ran = std::min(ran, n);
+        RowCursor scratch;
+        for (int g = 0; g < G; ++g) {
+          if (owner(g, n) != t) continue;
+          for (const uint32_t ci : s.contactGroups[g]) {
+            const auto [numRows, numPoints] = contactRows<RowMode::COUNT>(s, ci, k, scratch);
+            layout[ci] = {numRows, numPoints, 0, 0};
+          }
+        }
+      });
+      uint32_t row = 0, point = 0, coupling = 0;
+      for (int g = 0; g < G; ++g) {
+        for (const uint32_t ci : s.contactGroups[g]) {
+          ContactLayout& l = layout[ci];
+          const uint32_t numRows = l.row, numPoints = l.point;
+          l = {row, point, coupling, numRows};
+          row += numRows;
+          point += numPoints;
+          coupling += numRows > 0 ? 1 : 0;
+        }
+        s.rowGroupEnd[g] = row;
+      }
+      s.rows.resize(row);  // each contact writes its rows' defaults (RowMode::FILL)
+      s.pointRows.resize(point);
+      s.couplings.resize(coupling);
+      for (auto& list : s.rowBuildAnchors) list.clear();
+      runTeam(threads, [&](int t, int n) {
+        if (t == 0) ran = std::min(ran, n);
+        for (int g = 0; g < G; ++g) {
+          if (owner(g, n) != t) continue;
+          RowCursor cur;  // on this thread's stack: the tallies are written per point (no shared cache line)
+          cur.anchors = &s.rowBuildAnchors[g];
+          for (const uint32_t ci : s.contactGroups[g]) {
+            const ContactLayout& l = layout[ci];
+            if (l.count == 0) continue;
+            cur.row = l.row;
+            cur.point = l.point;
+            cur.coupling = l.coupling;
+            contactRows<RowMode::FILL>(s, ci, k, cur);
+          }
+          tally[g] = cur;
+        }
+      });
+      auto& active = s.frictionAnchors.active;
+      for (const auto& list : s.rowBuildAnchors) active.insert(active.end(), list.begin(), list.end());
     }
-    s.rows.resize(row);  // each contact writes its rows' defaults (RowMode::FILL)
-    s.pointRows.resize(point);
-    s.couplings.resize(coupling);
-    for (int t = 0; t < threads; ++t) s.rowBuildAnchors[t].clear();
-    runTeam(threads, [&](int t, int n) {
-      if (t == 0) ran = std::min(ran, n);
-      const auto [b, e] = half(t, n);
-      RowCursor cur;  // on this thread's stack: the tallies are written per point (no shared cache line)
-      cur.anchors = &s.rowBuildAnchors[t];
-      for (uint32_t ci = b; ci < e; ++ci) {
-        const ContactLayout& l = layout[ci];
-        if (l.count == 0) continue;
-        cur.row = l.row;
-        cur.point = l.point;
-        cur.coupling = l.coupling;
-        contactRows<RowMode::FILL>(s, ci, k, cur);
-      }
-      tally[t] = cur;
-    });
-    auto& active = s.frictionAnchors.active;
-    for (int t = 0; t < threads; ++t)
-      active.insert(active.end(), s.rowBuildAnchors[t].begin(), s.rowBuildAnchors[t].end());
   }
   s.solverStats().numRowBuildThreads = ran;
   s.rowBuildTeamBusy = ran < threads;

@@ -493,35 +493,34 @@ static void ensureBlockRows(std::vector<ConstraintRow>& rows, const std::vector<
     if (rows[i].blockCount > 1 && rows[i].blockBegin == int32_t(i)) ensureBlockRows(rows, bodies, i, blocks);
 }
 
-void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, PgsBlocks* blocks,
-                        bool deferBlockRows) {
-  // One pass over the rows: each row's M^-1 J^T and diagonal, then its warm-start impulse (row order, as the
-  // sweeps' bodies expect; the blocks below read only masses and inertias, so building them afterwards gives the
-  // same bits). The rows are about 300 bytes each: a second pass cost pyramid20 about 1 % (issue 18).
-  //
-  // DESIGN (issue 18, deferred block rows; docs/solver-internals.md "Rows prepared on first use"): the compact
-  // sweeps read a manifold's normal rows only through its block (G_a, W_a) and its points; their own M^-1 J^T
-  // and diagonals serve only the rare paths that leave the block (a bound hit, the shock pass's fallback
-  // sweeps). With deferBlockRows they are left to those paths (ensureBlockRows), and the block's warm start is
-  // applied per body: M^-1 (sum_i lambda_i J_i^T), the same impulse as the rows' one by one in another order
-  // of summation (last bits).
-  if (blocks) {
-    blocks->starts.clear();
-    blocks->anyDeferred = false;
-  }
-  for (size_t i = 0; i < rows.size(); ++i) {
+// Prepare's pass over rows [begin, end), in row order: each row's M^-1 J^T and diagonal, then its warm-start
+// impulse; a normal block's first row goes into blocks->starts at the next slot (from `slot` up), and its
+// operators are built afterwards (buildBlocks). With kFixedUntouched the warm start writes no static or
+// kinematic body (PgsPartition::movable): it adds nothing to them, and two ranges on two threads may share them.
+// A template so that the serial pass carries no test of it. Sets anyDeferred when a block's rows were left
+// unprepared; returns the slot after the last block.
+template <bool kFixedUntouched>
+static uint32_t prepareRange(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
+                             PgsBlocks* blocks, bool deferBlockRows, size_t begin, size_t end, uint32_t slot,
+                             bool& anyDeferred) {
+  auto writes = [&bodies](int32_t b) {
+    if constexpr (kFixedUntouched) return b >= 0 && PgsPartition::movable(bodies[size_t(b)]);
+    else return b >= 0;
+  };
+  for (size_t i = begin; i < end; ++i) {
     ConstraintRow& r = rows[i];
     SCREE_VALIDATE_CHECK(r.jLinA.allFinite() && r.jAngA.allFinite() && r.jLinB.allFinite() && r.jAngB.allFinite());
     if (blocks && r.blockCount > 1 && r.blockBegin == int32_t(i)) {
       const size_t n = size_t(r.blockCount);
-      const uint32_t slot = uint32_t(blocks->starts.size());
-      blocks->starts.push_back(uint32_t(i));
+      if (blocks->starts.size() <= slot) blocks->starts.resize(slot + 1);     // the serial pass: as they come
+      blocks->starts[slot] = uint32_t(i);
       if (blocks->blocks.size() <= slot) blocks->blocks.resize(slot + 1);  // grows only: reused across steps
-      bool defer = deferBlockRows && i + n <= rows.size();
+      bool defer = deferBlockRows && i + n <= end;
       for (size_t k = i + 1; defer && k < i + n; ++k)
         defer = rows[k].bodyA == r.bodyA && rows[k].bodyB == r.bodyB && rows[k].blockBegin == int32_t(i);
       blocks->blocks[slot].rowsReady = !defer;
-      blocks->anyDeferred = blocks->anyDeferred || defer;
+      ++slot;
+      anyDeferred = anyDeferred || defer;
       if (defer) {
         SCREE_ASSERT(r.bodyA < int32_t(bodies.size()) && r.bodyB < int32_t(bodies.size()));
         Vec3 lA = Vec3::Zero(), aA = Vec3::Zero(), lB = Vec3::Zero(), aB = Vec3::Zero();
@@ -539,12 +538,12 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
           aB += q.lambda * q.jAngB;
         }
         if (warm) {
-          if (r.bodyA >= 0) {
+          if (writes(r.bodyA)) {
             SolverBodyState& A = bodies[size_t(r.bodyA)];
             A.v += A.invMass * lA;
             A.w += A.invInertia * aA;
           }
-          if (r.bodyB >= 0) {
+          if (writes(r.bodyB)) {
             SolverBodyState& B = bodies[size_t(r.bodyB)];
             B.v += B.invMass * lB;
             B.w += B.invInertia * aB;
@@ -556,19 +555,101 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     }
     prepareRow(r, bodies);
     r.blockSlot = -1;
-    if (r.lambda != 0) applyImpulse(r, r.lambda, bodies);
+    if (r.lambda == 0) continue;
+    if constexpr (kFixedUntouched) {
+      if (writes(r.bodyA)) {
+        bodies[size_t(r.bodyA)].v += r.mJLinA * r.lambda;
+        bodies[size_t(r.bodyA)].w += r.mJAngA * r.lambda;
+      }
+      if (writes(r.bodyB)) {
+        bodies[size_t(r.bodyB)].v += r.mJLinB * r.lambda;
+        bodies[size_t(r.bodyB)].w += r.mJAngB * r.lambda;
+      }
+    } else {
+      applyImpulse(r, r.lambda, bodies);
+    }
   }
+  return slot;
+}
+
+// The operators of the blocks in slots [begin, end) (prepareRange recorded their first rows), after the pass:
+// they read only masses, inertias and the rows' Jacobians, none of which the pass changes.
+static void buildBlocks(std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                        PgsBlocks& blocks, uint32_t begin, uint32_t end) {
+  for (uint32_t slot = begin; slot < end; ++slot) {
+    const uint32_t i = blocks.starts[slot];
+    buildBlock(rows.data() + i, bodies, blocks.blocks[slot]);
+    rows[i].blockSlot = int32_t(slot);
+  }
+}
+
+void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, PgsBlocks* blocks,
+                        bool deferBlockRows) {
+  // One pass over the rows: each row's M^-1 J^T and diagonal, then its warm-start impulse (row order, as the
+  // sweeps' bodies expect; the blocks below read only masses and inertias, so building them afterwards gives the
+  // same bits). The rows are about 300 bytes each: a second pass cost pyramid20 about 1 % (issue 18).
+  //
+  // DESIGN (issue 18, deferred block rows; docs/solver-internals.md "Rows prepared on first use"): the compact
+  // sweeps read a manifold's normal rows only through its block (G_a, W_a) and its points; their own M^-1 J^T
+  // and diagonals serve only the rare paths that leave the block (a bound hit, the shock pass's fallback
+  // sweeps). With deferBlockRows they are left to those paths (ensureBlockRows), and the block's warm start is
+  // applied per body: M^-1 (sum_i lambda_i J_i^T), the same impulse as the rows' one by one in another order
+  // of summation (last bits).
   if (blocks) {
+    blocks->starts.clear();
     // The compact manifold records (PgsSolver::iterate) describe last step's rows until iterate rebuilds them.
     blocks->manifolds.clear();
     blocks->points.clear();
     blocks->plan.clear();
-    const size_t count = blocks->starts.size();
-    for (size_t slot = 0; slot < count; ++slot) {
-      const uint32_t i = blocks->starts[slot];
-      buildBlock(rows.data() + i, bodies, blocks->blocks[slot]);
-      rows[i].blockSlot = int32_t(slot);
-    }
+  }
+  bool anyDeferred = false;
+  const uint32_t slots = prepareRange<false>(rows, bodies, blocks, deferBlockRows, 0, rows.size(), 0, anyDeferred);
+  if (blocks) {
+    blocks->anyDeferred = anyDeferred;
+    buildBlocks(rows, bodies, *blocks, 0, slots);
+  }
+}
+
+void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, PgsBlocks* blocks,
+                        bool deferBlockRows, const PrepareGroups& groups) {
+  constexpr int R = PgsPartition::kRegions;
+  SCREE_ASSERT(groups.rowEnd[R - 1] <= rows.size());
+  // Slots: each group's from its first row's half (a block has two rows or more), so that the groups' blocks
+  // never share a slot; the tail's after them. Holes stay unused.
+  uint32_t slotBase[R + 1];
+  uint32_t rowBegin = 0, slots = 0;
+  for (int g = 0; g < R; ++g) {
+    slotBase[g] = slots;
+    slots += (groups.rowEnd[g] - rowBegin) / 2;
+    rowBegin = groups.rowEnd[g];
+  }
+  slotBase[R] = slots;
+  if (blocks) {
+    blocks->starts.assign(slots, UINT32_MAX);
+    if (blocks->blocks.size() < slots) blocks->blocks.resize(slots);  // grows only: reused across steps
+    blocks->manifolds.clear();
+    blocks->points.clear();
+    blocks->plan.clear();
+  }
+  bool deferred[R + 1] = {};
+  runTeam(groups.threads, [&](int t, int nt) {
+    if (nt < groups.threads && groups.teamBusy) *groups.teamBusy = true;  // only the calling thread runs then
+    for (int g = 0; g < R; ++g)
+      if (g % nt == t) {
+        const uint32_t end = prepareRange<true>(rows, bodies, blocks, deferBlockRows,
+                                                g == 0 ? 0 : groups.rowEnd[g - 1], groups.rowEnd[g], slotBase[g],
+                                                deferred[g]);
+        if (blocks) buildBlocks(rows, bodies, *blocks, slotBase[g], end);
+      }
+  });
+  // The boundary's contacts and every other row (joints) after both regions, on this thread: every body's
+  // impulses are summed in row order, as by the serial pass over the same rows.
+  const uint32_t end = prepareRange<false>(rows, bodies, blocks, deferBlockRows, groups.rowEnd[R - 1], rows.size(),
+                                           slotBase[R], deferred[R]);
+  if (blocks) buildBlocks(rows, bodies, *blocks, slotBase[R], end);
+  if (blocks) {
+    blocks->anyDeferred = false;
+    for (const bool d : deferred) blocks->anyDeferred = blocks->anyDeferred || d;
   }
 }
 
@@ -876,7 +957,9 @@ struct VisitBodies {
   SCREE_VISIT_INLINE Real rowVelocity(const Vec3& l, const Vec6& ang) const { return l.dot(vA - vB) + ang.dot(w); }
   /// The linear velocity change of an impulse d along the A-side direction l.
   /// Written per component: as `vA += (m.imA * d) * l`, GCC called Eigen's assignment loop out of line from
-  /// the visit (a call per push, its operands through memory). The same products, so the same bits.
+  /// the visit (a call per push, its operands through memory). The same products, so the same bits. The visit's
+  /// updates of the 6-vector w are written per component for the same reason (GCC outlined them after an
+  /// unrelated change elsewhere in this file, December 2026: pyramid20's sweeps took 4 % more instructions).
   SCREE_VISIT_INLINE void push(const PgsBlocks::Manifold& m, const Vec3& l, Real d) {
     const Real ka = m.imA * d, kb = m.imB * d;
     for (int k = 0; k < 3; ++k) {
@@ -901,7 +984,7 @@ SCREE_VISIT_INLINE inline Real compactFriction(PgsBlocks::Manifold& m, VisitBodi
     const Real nl = std::clamp(m.lambda[k] + delta, -lim, lim);
     const Real d = nl - m.lambda[k];
     m.lambda[k] = nl;
-    V.w += m.w[3 + k] * d;
+    for (int j = 0; j < 6; ++j) V.w[j] += m.w[3 + k][j] * d;  // per component: see push
     if (k < 2) V.push(m, m.lin[1 + k], d);
     maxDelta = std::max(maxDelta, std::abs(d));
   };
@@ -914,7 +997,7 @@ SCREE_VISIT_INLINE inline Real compactFriction(PgsBlocks::Manifold& m, VisitBodi
     d2 = l2 - m.lambda[1];
     m.lambda[0] = l1;
     m.lambda[1] = l2;
-    V.w += m.w[3] * d1 + m.w[4] * d2;
+    for (int j = 0; j < 6; ++j) V.w[j] += m.w[3][j] * d1 + m.w[4][j] * d2;  // per component: see push
     const Vec3 dl = m.lin[1] * d1 + m.lin[2] * d2;
     V.push(m, dl, 1.0);
     maxDelta = std::max(maxDelta, std::max(std::abs(d1), std::abs(d2)));
@@ -981,7 +1064,8 @@ SCREE_VISIT_INLINE static inline Real compactBlock(PgsBlocks& pb, PgsBlocks::Man
         m.slu = slu;
         m.slv = slv;
         m.sumN = pos;
-        V.w += m.w[0] * dmu[0] + m.w[1] * dmu[1] + m.w[2] * dmu[2];
+        for (int j = 0; j < 6; ++j)  // per component, as push says; Eigen's order of the sum
+          V.w[j] += (m.w[0][j] * dmu[0] + m.w[1][j] * dmu[1]) + m.w[2][j] * dmu[2];
         V.push(m, m.lin[0], dmu[0]);
         return maxD;
       }

@@ -25,7 +25,7 @@
 namespace scree::detail {
 
 namespace {
-inline bool movableBody(const SolverBodyState& b) { return b.invMass > 0 || !b.invInertia.isZero(0); }
+inline bool movableBody(const SolverBodyState& b) { return PgsPartition::movable(b); }
 /// A unit's movable bodies (a unit's rows all act on the same two bodies); returns how many (0-2).
 int movableBodies(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
                   const PgsPartition::Unit& un, int32_t out[2]) {

@@ -103,8 +103,8 @@ struct SimulationState {
   // started (adaptive count). It counts when this step's sweeps were partitioned too (partitionReady).
   std::chrono::steady_clock::time_point partitionSpanStart{};
   bool partitionSpanStarted = false;
-  // Some team job of this step's row build got fewer threads than it asked for (another Simulation held the
-  // team); the sweeps' and shock pass's jobs report theirs in partition.teamBusy.
+  // Some team job of this step's row build or prepare got fewer threads than it asked for (another Simulation
+  // held the team); the sweeps' and shock pass's jobs report theirs in partition.teamBusy.
   bool rowBuildTeamBusy = false;
   // Warm-start source (issue 18, solve_stage.cpp rigidShock): per contact row in the rigid shock pass, the
   // sweeps' impulse (plus, for a single support's normal rows, an even share of the load the pass added); NaN for
@@ -119,10 +119,16 @@ struct SimulationState {
   // ---- issue 18 (friction anchors, friction_anchor.h): manifold anchors kept across steps and this step's
   // anchored manifolds (Solver::setUseFrictionAnchors) ----
   FrictionAnchorCache frictionAnchors;
-  // ---- issue 18 (two-thread scaling): the parallel contact row build's layout and per-thread anchor lists
-  // (contact_rows.cpp), kept across steps ----
+  // ---- issue 18 (two-thread scaling): the grouped contact row build (contact_rows.cpp): the contacts of each
+  // group (the regions', then the boundary's), their layout and per-group anchor lists, kept across steps; the
+  // end of each group's rows (rows [rowGroupEnd[g - 1], rowGroupEnd[g]) are group g's) ----
+  std::vector<uint32_t> contactGroups[PgsPartition::kRegions + 1];
   std::vector<ContactLayout> contactLayout;
-  std::vector<FrictionAnchorCache::Active> rowBuildAnchors[PgsPartition::kRegions];
+  std::vector<FrictionAnchorCache::Active> rowBuildAnchors[PgsPartition::kRegions + 1];
+  uint32_t rowGroupEnd[PgsPartition::kRegions + 1] = {};
+  bool rowGroupsReady = false;  // this step's contact rows are grouped (PgsSolver::prepare runs the regions apart)
+  int rowGroupThreads = 1;      // the threads the grouped build asked for, which prepare asks for too
+  std::vector<uint32_t> couplingOrder;  // shock_order.cpp: the couplings in contact order (grouped rows)
 
   // ---- position projection: its own direct solver, so each keeps its cached symbolic analysis ---------------
   DirectSolver projector;

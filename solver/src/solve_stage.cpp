@@ -374,7 +374,18 @@ void solve(SimulationState& s) {
   const SolvePath path = choosePath(s);
   const bool deferBlockRows = (path == SolvePath::ITERATIVE || path == SolvePath::INTERLEAVED) &&
                               (s.solver.getUsePartitionedSweeps() || !s.solver.getUseColouredSweeps());
-  if (!s.rows.empty()) PgsSolver::prepare(s.rows, s.sb, &s.pgsBlocks, deferBlockRows);
+  if (s.rows.empty()) {
+  } else if (s.rowGroupsReady) {
+    // Issue 18 (two-thread scaling): the regions' rows on the row build's threads, which laid them out by region
+    // (contact_rows.cpp).
+    PgsSolver::PrepareGroups groups;
+    for (int g = 0; g < PgsPartition::kRegions; ++g) groups.rowEnd[g] = s.rowGroupEnd[g];
+    groups.threads = s.rowGroupThreads;
+    groups.teamBusy = &s.rowBuildTeamBusy;
+    PgsSolver::prepare(s.rows, s.sb, &s.pgsBlocks, deferBlockRows, groups);
+  } else {
+    PgsSolver::prepare(s.rows, s.sb, &s.pgsBlocks, deferBlockRows);
+  }
   if (particleDirect) s.particles.loadDirectImpulses(s.rows);
   else if (particles) s.particles.prepare(s.granular, s.sb);
 

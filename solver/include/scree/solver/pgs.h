@@ -168,6 +168,8 @@ struct PgsColouring {
 /// units (their bodies and row counts, in order) stay the same as when it was made.
 struct PgsPartition {
   static constexpr int kRegions = 2;
+  /// A body the sweeps move (dynamic): what the regions hold. Static and kinematic bodies belong to no region.
+  static bool movable(const SolverBodyState& b) { return b.invMass > 0 || !b.invInertia.isZero(0); }
   struct Unit {
     uint32_t begin, count;
   };
@@ -216,6 +218,21 @@ class PgsSolver {
   /// subset sweeps nor DIRECT, which read the rows directly.
   static void prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                       PgsBlocks* blocks = nullptr, bool deferBlockRows = false);
+  /// Rows laid out by region (the grouped contact row build, contact_rows.cpp): rows [0, rowEnd[0]) act on no
+  /// movable body outside region 0, rows [rowEnd[0], rowEnd[1]) on none outside region 1, the rows after them
+  /// on any (PgsPartition).
+  struct PrepareGroups {
+    uint32_t rowEnd[PgsPartition::kRegions] = {};
+    int threads = 1;              ///< threads asked of the team (scree/core/parallel.h)
+    bool* teamBusy = nullptr;     ///< set when the team gave fewer (another Simulation held it)
+  };
+  /// prepare on grouped rows: the regions' rows on up to `groups.threads` threads at once, then the rest on the
+  /// calling thread. Every body's warm-start impulses are summed in row order, so the bits are the serial
+  /// prepare's on the same rows, except that static and kinematic bodies get no write (their velocities, to
+  /// which the warm start adds zero, keep their bits). A block's slot is not its rank: each region's blocks get
+  /// slots from a base of their own, PgsBlocks::starts holds UINT32_MAX in the unused ones.
+  static void prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, PgsBlocks* blocks,
+                      bool deferBlockRows, const PrepareGroups& groups);
   /// `iterations` sweeps over all rows in order. Returns the largest |delta lambda| of the last sweep. `blocks`
   /// must be the one given to prepare (or null).
   /// With `blocks`, manifold contacts are swept from compact copies (PgsBlocks::Manifold) built at entry and
