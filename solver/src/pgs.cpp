@@ -612,6 +612,9 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
 
 void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, PgsBlocks* blocks,
                         bool deferBlockRows, const PrepareGroups& groups) {
+  // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "The contact rows by region"): the regions'
+  // rows share no movable body, so each body's warm-start impulses come from one region's rows, then from the
+  // rest's, in row order, on whichever thread; static and kinematic bodies, which both share, are not written.
   constexpr int R = PgsPartition::kRegions;
   SCREE_ASSERT(groups.rowEnd[R - 1] <= rows.size());
   // Slots: each group's from its first row's half (a block has two rows or more), so that the groups' blocks

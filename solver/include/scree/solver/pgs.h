@@ -62,7 +62,9 @@ struct PgsBlocks {
     mutable bool rowsReady = true;
   };
   std::vector<Block> blocks;
-  std::vector<uint32_t> starts;  ///< PgsSolver::prepare: each block's first row, in row order (slot order)
+  /// PgsSolver::prepare: each block's first row, in row order (slot order); after the grouped prepare each
+  /// group's blocks from the group's own base slot, UINT32_MAX in the slots left unused.
+  std::vector<uint32_t> starts;
   /// Whether PgsSolver::prepare left any block's rows unprepared (Block::rowsReady): the passes that prepare
   /// every deferred block of a range return at once when none is.
   bool anyDeferred = false;

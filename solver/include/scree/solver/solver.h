@@ -165,8 +165,9 @@ class Solver {
   /// contacts and joints inside each region are swept by their own thread, those across the cut by one thread
   /// between barriers (one barrier per sweep instead of one per colour). The shock pass runs the supports of
   /// each region on their own thread in the same dependency order (its result equals the serial pass's). With 128
-  /// contacts or more the contact rows are built on the same threads too, each a fixed half of the contacts
-  /// (SolverStats::numRowBuildThreads). Results are bit-identical for any thread count (setNumThreads). The
+  /// contacts or more the contact rows are laid out region by region (by the last step's regions) and built and
+  /// prepared (warm start) on the region's thread too (SolverStats::numRowBuildThreads). Results are
+  /// bit-identical for any thread count (setNumThreads). The
   /// sweep order differs from the default serial order (each region's contacts, then those across the cut), so
   /// trajectories differ from the default's. Takes precedence over setUseColouredSweeps when both are on.
   void setUsePartitionedSweeps(bool on) { partitionedSweeps_ = on; }
