@@ -192,9 +192,10 @@ TEST_CASE("partitioned sweeps: pyramid20 is bit-identical on 1 and 2 threads, wi
     const auto [one, m1] = runPartitioned(1, shock, steps, &rowsOne);
     const auto [two, m2] = runPartitioned(2, shock, steps, &rowsTwo);
     REQUIRE(one.size() == two.size());
-    // The contact rows too were built on two threads in every step of the 2-thread run (pyramid20 has about 400
-    // contacts, above the build's threshold of 128), and on one in the 1-thread run: the bits below then also
-    // check that each thread's half gives the serial build's rows (contact_rows.cpp).
+    // The contact rows too were built (and prepared) on two threads in every step but the first of the 2-thread
+    // run (pyramid20 has about 400 contacts, above the build's threshold of 128), and on one in the 1-thread run:
+    // the bits below then also check that each region's rows, built and prepared on its own thread, are the
+    // one-thread run's (contact_rows.cpp, pgs.cpp PgsSolver::prepare with PrepareGroups).
     CHECK(rowsOne == 1);
     if (twoThreads) CHECK(rowsTwo == 2);
     // Bit for bit: the two regions touch disjoint dynamic bodies (sweeps), and each shock range waits for the
@@ -212,12 +213,12 @@ TEST_CASE("partitioned sweeps: pyramid20 is bit-identical on 1 and 2 threads, wi
 }
 
 TEST_CASE("contact rows built on two threads: the serial build's bits for every kind of contact row") {
-  // The row build of the partitioned path (contact_rows.cpp) cuts the contacts in halves, counts each half's rows
-  // on its thread, places them, then fills them. Its count must agree with the fill for every row layout, not
+  // The row build of the partitioned path (contact_rows.cpp) groups the contacts by region, counts each region's
+  // rows on its thread, places them, then fills them. Its count must agree with the fill for every row layout, not
   // only pyramid20's manifold friction. A 12-row pyramid (78 boxes) beside a row of 48 spheres on the ground, in
   // four variants: the default (box manifolds with manifold friction and single sphere points), rolling
   // resistance (per-point friction and rolling rows), the box friction model (per-point box friction), and
-  // friction anchors (Solver::setUseFrictionAnchors: each thread lists its anchored manifolds, joined in contact
+  // friction anchors (Solver::setUseFrictionAnchors: each group lists its anchored manifolds, joined in row
   // order). 90 steps: the spheres fall 1.7 m and land at about step 35 (0.59 s at 60 Hz), and for the rest the
   // contacts' warm starts and anchors are in use.
   setNumThreads(2);
