@@ -374,8 +374,7 @@ void solve(SimulationState& s) {
   const SolvePath path = choosePath(s);
   const bool deferBlockRows = (path == SolvePath::ITERATIVE || path == SolvePath::INTERLEAVED) &&
                               (s.solver.getUsePartitionedSweeps() || !s.solver.getUseColouredSweeps());
-  if (s.rows.empty()) {
-  } else if (s.rowGroupsReady) {
+  if (!s.rows.empty() && s.rowGroupsReady) {
     // Issue 18 (two-thread scaling): the regions' rows on the row build's threads, which laid them out by region
     // (contact_rows.cpp).
     PgsSolver::PrepareGroups groups;
@@ -383,7 +382,7 @@ void solve(SimulationState& s) {
     groups.threads = s.rowGroupThreads;
     groups.teamBusy = &s.rowBuildTeamBusy;
     PgsSolver::prepare(s.rows, s.sb, &s.pgsBlocks, deferBlockRows, groups);
-  } else {
+  } else if (!s.rows.empty()) {
     PgsSolver::prepare(s.rows, s.sb, &s.pgsBlocks, deferBlockRows);
   }
   if (particleDirect) s.particles.loadDirectImpulses(s.rows);
