@@ -601,6 +601,7 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     blocks->manifolds.clear();
     blocks->points.clear();
     blocks->plan.clear();
+    blocks->rowManifold.clear();
   }
   bool anyDeferred = false;
   const uint32_t slots = prepareRange<false>(rows, bodies, blocks, deferBlockRows, 0, rows.size(), 0, anyDeferred);
@@ -630,8 +631,10 @@ void PgsSolver::prepare(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   if (blocks) {
     blocks->starts.assign(slots, UINT32_MAX);
     if (blocks->blocks.size() < slots) blocks->blocks.resize(slots);  // grows only: reused across steps
-    blocks->manifolds.clear();
-    blocks->points.clear();
+    // Last step's compact records are made unreachable (no record starts at any row), not cleared: the
+    // partitioned iterate writes each record in place on the thread that sweeps it, and a cleared vector would be
+    // refilled with zeros on this thread first (928 bytes a record), which the other thread then fetches.
+    blocks->rowManifold.assign(rows.size(), -1);
     blocks->plan.clear();
   }
   bool deferred[R + 1] = {};
@@ -833,11 +836,10 @@ void updateSums(PgsBlocks::Manifold& m, const PgsBlocks::Point* P) {
   m.sumN = pos;
 }
 
-/// Appends the compact record of the manifold contact whose rows start at row i (n normal rows; isCompactManifold
-/// and fitsCompactLayout hold).
-void appendCompact(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
-                   PgsBlocks& pb, size_t i, int n) {
-  PgsBlocks::Manifold& m = pb.manifolds.emplace_back();
+/// Writes the compact record m of the manifold contact whose rows start at row i (n normal rows; isCompactManifold
+/// and fitsCompactLayout hold), its points at pb.points[point, point + n) (already sized).
+void writeCompact(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                  PgsBlocks& pb, PgsBlocks::Manifold& m, uint32_t point, size_t i, int n) {
   const ConstraintRow& t1 = rows[i];
   m.a = t1.bodyA;
   m.b = t1.bodyB;
@@ -845,7 +847,7 @@ void appendCompact(const std::vector<ConstraintRow>& rows, const std::vector<Sol
   m.imB = m.b >= 0 ? bodies[size_t(m.b)].invMass : 0.0;
   m.row = uint32_t(i);
   m.block = uint32_t(rows[i + 3].blockSlot);
-  m.point = uint32_t(pb.points.size());
+  m.point = point;
   m.n = n;
   m.cone = t1.pairedRow == int32_t(i) + 1;
   m.mu = t1.mu;
@@ -874,9 +876,23 @@ void appendCompact(const std::vector<ConstraintRow>& rows, const std::vector<Sol
   m.axisV = B.axisV;
   for (int k = 0; k < n; ++k) {
     const ConstraintRow& r = rows[i + 3 + size_t(k)];
-    pb.points.push_back({r.blockU, r.blockV, r.e, r.lambda, r.lo});
+    pb.points[point + uint32_t(k)] = {r.blockU, r.blockV, r.e, r.lambda, r.lo};
   }
   updateSums(m, pb.points.data() + m.point);
+}
+
+/// Appends the compact record of the manifold contact whose rows start at row i (writeCompact).
+void appendCompact(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                   PgsBlocks& pb, size_t i, int n) {
+  const uint32_t point = uint32_t(pb.points.size());
+  pb.points.resize(pb.points.size() + size_t(n));
+  writeCompact(rows, bodies, pb, pb.manifolds.emplace_back(), point, i, n);
+}
+
+/// Writes the impulses of record m back into its rows.
+void writeBackRecord(std::vector<ConstraintRow>& rows, const PgsBlocks& pb, const PgsBlocks::Manifold& m) {
+  for (int k = 0; k < 3; ++k) rows[m.row + uint32_t(k)].lambda = m.lambda[k];
+  for (int k = 0; k < m.n; ++k) rows[m.row + 3 + uint32_t(k)].lambda = pb.points[m.point + uint32_t(k)].lambda;
 }
 
 /// True when the rows starting at i form a manifold contact of the compact form; n its normal rows.
@@ -908,11 +924,8 @@ void buildCompact(std::vector<ConstraintRow>& rows, const std::vector<SolverBody
 }
 
 void writeBackCompact(std::vector<ConstraintRow>& rows, const PgsBlocks& pb) {
-  for (const PgsBlocks::Manifold& m : pb.manifolds) {
-    if (m.n < 0) continue;  // a gap between regions (PgsSolver::iterate with a partition)
-    for (int k = 0; k < 3; ++k) rows[m.row + uint32_t(k)].lambda = m.lambda[k];
-    for (int k = 0; k < m.n; ++k) rows[m.row + 3 + uint32_t(k)].lambda = pb.points[m.point + uint32_t(k)].lambda;
-  }
+  for (const PgsBlocks::Manifold& m : pb.manifolds)
+    if (m.n >= 0) writeBackRecord(rows, pb, m);
 }
 
 using Vec6 = PgsBlocks::Vec6;
@@ -1738,12 +1751,14 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   };
   auto movableBody = [&](int32_t b) { return size_t(b) < p.bodyRegion.size() && p.bodyRegion[size_t(b)] >= 0; };
   // The bodies' local layout (PgsPartition::local): per region its movable bodies, the static and kinematic
-  // bodies its units touch (private copies), then a gap.
+  // bodies its units touch (private copies), then a gap; region g's slots are [slots[g], slots[g + 1]).
   constexpr int kGapBodies = 8;    // 1 KB: more than the two-line pairs the L2 prefetcher fetches together
   constexpr int kGapPoints = 32;   // about 1 KB of PgsBlocks::Point likewise
+  size_t slots[R + 1];
   p.globalOf.clear();
   p.localOf.assign(size_t(R) * nb, -1);
   for (int g = 0; g < R; ++g) {
+    slots[g] = p.globalOf.size();
     for (size_t b = 0; b < nb; ++b)
       if (movableBody(int32_t(b)) && p.bodyRegion[b] == g) {
         for (int h = 0; h < R; ++h) p.localOf[size_t(h) * nb + b] = int32_t(p.globalOf.size());
@@ -1759,47 +1774,85 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     });
     p.globalOf.insert(p.globalOf.end(), kGapBodies, -1);
   }
+  slots[R] = p.globalOf.size();
   p.local.resize(p.globalOf.size());
-  for (size_t k = 0; k < p.globalOf.size(); ++k)
-    p.local[k] = p.globalOf[k] >= 0 ? bodies[size_t(p.globalOf[k])] : SolverBodyState{};
-  // Each unit's compact record (-1: its ConstraintRows), laid out region by region with a gap after each group,
-  // so that no cache line (nor the line the prefetcher pairs with it) holds records of two threads.
+  // Each unit's compact record (-1: its ConstraintRows), laid out group by group (region 0, region 1, boundary)
+  // with a gap record and kGapPoints points after each group, so that no cache line (nor the line the prefetcher
+  // pairs with it) holds records of two threads. Unit u of group g owns record u + g (a unit that is no compact
+  // manifold leaves its record unused, n = -1) and, when it may be one (3 + n rows, n >= 2), n points from its
+  // group's running count: the places follow from the units alone, so each thread fills its own groups' records.
   const size_t nu = p.order.size();
   p.unitManifold.assign(nu, -1);
+  uint32_t pointBase[R + 2] = {};
   if (blocks) {
     PgsBlocks& pb = *blocks;
-    pb.manifolds.clear();
-    pb.points.clear();
     pb.plan.clear();
     pb.rowManifold.assign(rows.size(), -1);
+    pb.manifolds.resize(nu + R + 1);
     for (int g = 0; g <= R; ++g) {
-      for (uint32_t u = split[g]; u < split[g + 1]; ++u) {
-        int n = 0;
-        const uint32_t i = p.order[u].begin;
-        if (!compactUnit(rows, pb, i, n) || 3 + uint32_t(n) != p.order[u].count) continue;
-        p.unitManifold[u] = int32_t(pb.manifolds.size());
-        pb.rowManifold[i] = int32_t(pb.manifolds.size());
-        appendCompact(rows, bodies, pb, i, n);
-        PgsBlocks::Manifold& m = pb.manifolds.back();
-        const size_t view = size_t(g < R ? g : 0) * nb;
+      uint32_t points = 0;
+      for (uint32_t u = split[g]; u < split[g + 1]; ++u)
+        if (p.order[u].count >= 5) points += p.order[u].count - 3;
+      pointBase[g + 1] = pointBase[g] + points + kGapPoints;
+      pb.manifolds[split[g + 1] + uint32_t(g)].n = -1;  // the gap after group g, never visited
+    }
+    pb.points.resize(pointBase[R + 1]);
+  }
+  // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "Each thread lays out and takes down its
+  // region"): the local bodies, the records and the re-indexed rows of a group are written on the thread that
+  // sweeps the group, and its impulses and velocities written back there, so that a region's rows (built and
+  // prepared on its thread, contact_rows.cpp and PgsSolver::prepare) and its records stay in that thread's cache.
+  // Stop 45 and before, the program thread read every row to lay out the records and wrote every row's impulse
+  // back, so the second region's rows crossed between the cores twice per step. Same operations on the same data
+  // in the same order per record and per body, so the same bits on any thread count.
+  auto layOut = [&](int g) {
+    const size_t view = size_t(g < R ? g : 0) * nb;
+    uint32_t point = pointBase[g];
+    for (uint32_t u = split[g]; u < split[g + 1]; ++u) {
+      const uint32_t i = p.order[u].begin;
+      int n = 0;
+      if (blocks && compactUnit(rows, *blocks, i, n) && 3 + uint32_t(n) == p.order[u].count) {
+        PgsBlocks& pb = *blocks;
+        const int32_t record = int32_t(u) + g;
+        p.unitManifold[u] = record;
+        pb.rowManifold[i] = record;
+        PgsBlocks::Manifold& m = pb.manifolds[size_t(record)];
+        writeCompact(rows, bodies, pb, m, point, i, n);
+        point += uint32_t(n);
         if (m.a >= 0 && size_t(m.a) < nb) m.a = p.localOf[view + size_t(m.a)];
         if (m.b >= 0 && size_t(m.b) < nb) m.b = p.localOf[view + size_t(m.b)];
+        continue;
       }
-      pb.manifolds.emplace_back().n = -1;  // a gap (about 1 KB), never visited
-      pb.points.resize(pb.points.size() + kGapPoints, PgsBlocks::Point{0, 0, 0, 0, 0});
+      if (blocks) blocks->manifolds[u + uint32_t(g)].n = -1;
+      if (p.order[u].count >= 5) point += p.order[u].count - 3;
+      // Swept as ConstraintRows: a deferred normal block's rows are prepared first, on the shared bodies; then the
+      // rows index the local layout until the end of the sweeps (a compact record's rows keep the shared
+      // indices: compactBlock's fallback maps them for its call).
+      ensureBlockRows(rows, bodies, i, i + p.order[u].count, blocks);
+      for (uint32_t r = i; r < i + p.order[u].count; ++r)
+        for (int32_t* b : {&rows[r].bodyA, &rows[r].bodyB})
+          if (*b >= 0 && size_t(*b) < nb) *b = p.localOf[view + size_t(*b)];
     }
-  }
-  // The rows of the other units (joints, single contacts) index the local layout until the end of the sweeps
-  // (a compact record's rows keep the shared indices: compactBlock's fallback maps them for its call).
-  for (int g = 0; g < R; ++g)
-    forUnitsOf(g, [&](uint32_t u) {
-      if (p.unitManifold[u] >= 0) return;
-      // Swept as ConstraintRows: a deferred normal block's rows are prepared first, on the shared bodies.
-      ensureBlockRows(rows, bodies, p.order[u].begin, p.order[u].begin + p.order[u].count, blocks);
-      for (uint32_t i = p.order[u].begin; i < p.order[u].begin + p.order[u].count; ++i)
-        for (int32_t* b : {&rows[i].bodyA, &rows[i].bodyB})
-          if (*b >= 0 && size_t(*b) < nb) *b = p.localOf[size_t(g) * nb + size_t(*b)];
-    });
+  };
+  // Back to the shared indices (the shock pass reads them) and the impulses into the rows.
+  auto toShared = [&](int32_t& b) {
+    if (b >= 0 && size_t(b) < p.globalOf.size()) b = p.globalOf[size_t(b)];
+  };
+  auto takeDown = [&](int g) {
+    for (uint32_t u = split[g]; u < split[g + 1]; ++u) {
+      if (p.unitManifold[u] >= 0) {
+        PgsBlocks::Manifold& m = blocks->manifolds[size_t(p.unitManifold[u])];
+        writeBackRecord(rows, *blocks, m);
+        toShared(m.a);
+        toShared(m.b);
+        continue;
+      }
+      for (uint32_t i = p.order[u].begin; i < p.order[u].begin + p.order[u].count; ++i) {
+        toShared(rows[i].bodyA);
+        toShared(rows[i].bodyB);
+      }
+    }
+  };
   std::vector<SolverBodyState>& lb = p.local;
   const PgsPartition::Unit* order = p.order.data();
   const int32_t* manifold = p.unitManifold.data();
@@ -1809,10 +1862,19 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   TeamBarrier barrier(threads);
   runTeam(threads, [&](int t, int nt) {
     if (nt < threads) p.teamBusy = true;  // only the calling thread runs then (nt == 1)
+    auto owns = [&](int g) { return (g < R ? g % nt : 0) == t; };  // the boundary's group is thread 0's
+    // Lay out: this thread's regions' local bodies, then its groups' records and rows. The boundary's first
+    // visit comes after the first sweep's barrier, when the other region's local bodies are in place.
+    for (int g = 0; g < R; ++g)
+      if (owns(g))
+        for (size_t k = slots[g]; k < slots[g + 1]; ++k)
+          lb[k] = p.globalOf[k] >= 0 ? bodies[size_t(p.globalOf[k])] : SolverBodyState{};
+    for (int g = 0; g <= R; ++g)
+      if (owns(g)) layOut(g);
     Real local = 0;
     auto regions = [&](bool forward) {
       for (int g = 0; g < R; ++g)
-        if (g % nt == t)
+        if (owns(g))
           local = std::max(local, sweepUnits(rows, lb, order, manifold, split[g], split[g + 1], forward, blocks));
     };
     auto boundaryUnits = [&](bool forward) {
@@ -1829,29 +1891,19 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
       else regions(false);
     }
     if (t < R) lastSweep[t] = local;
+    // Take down: the groups' impulses and indices (no other thread reads them), then, once the boundary's last
+    // sweep is over (a forward sweep ends with it), the regions' movable bodies (the static copies changed
+    // nothing).
+    for (int g = 0; g <= R; ++g)
+      if (owns(g)) takeDown(g);
+    if (boundary && nt > 1 && iterations > 0 && (iterations - 1) % 2 == 0) barrier.wait();
+    for (int g = 0; g < R; ++g)
+      if (owns(g))
+        for (size_t k = slots[g]; k < slots[g + 1]; ++k)
+          if (p.globalOf[k] >= 0 && movableBody(p.globalOf[k])) bodies[size_t(p.globalOf[k])] = lb[k];
   });
   Real maxDelta = 0;
   for (int t = 0; t < R; ++t) maxDelta = std::max(maxDelta, lastSweep[t]);
-  if (blocks) writeBackCompact(rows, *blocks);
-  // Back to the shared bodies: the movable bodies' velocities (the static copies changed nothing), the rows' and
-  // the records' body indices (the shock pass reads them).
-  for (size_t k = 0; k < p.globalOf.size(); ++k)
-    if (p.globalOf[k] >= 0 && movableBody(p.globalOf[k])) bodies[size_t(p.globalOf[k])] = lb[k];
-  auto toShared = [&](int32_t& b) {
-    if (b >= 0 && size_t(b) < p.globalOf.size()) b = p.globalOf[size_t(b)];
-  };
-  for (size_t u = 0; u < nu; ++u)
-    if (p.unitManifold[u] < 0)
-      for (uint32_t i = p.order[u].begin; i < p.order[u].begin + p.order[u].count; ++i) {
-        toShared(rows[i].bodyA);
-        toShared(rows[i].bodyB);
-      }
-  if (blocks)
-    for (PgsBlocks::Manifold& m : blocks->manifolds)
-      if (m.n >= 0) {
-        toShared(m.a);
-        toShared(m.b);
-      }
   return maxDelta;
 }
 
