@@ -7,6 +7,7 @@
 // the binary search's range (pairRange).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -86,5 +87,70 @@ TEST_CASE("warm-start cache: an empty cache gives empty ranges") {
   for (uint64_t q : {uint64_t(0), uint64_t(5), uint64_t(1) << 40}) {
     const auto r = c.pairRangeAscending(q);
     CHECK(r.first == r.second);
+  }
+}
+
+// The store in place (store_results.cpp with rows grouped by region): each contact's entries are written at the
+// place the contacts before it leave free, by whichever thread stores the contact and in any order of contacts,
+// each contact's run is ordered by feature (sortRun), then commitPlaced. It must give the cache that add() in
+// contact order and commit() give -- entry for entry -- including over last step's larger storage, and when the
+// contacts' pairs do not ascend (commitPlaced then sorts everything, as commit does).
+TEST_CASE("warm-start cache: the store in place gives the entries of add and commit") {
+  std::mt19937 rng(11);
+  WarmStartCache placed, added;
+  for (int round = 0; round < 4; ++round) {
+    const bool ascending = round % 2 == 0;
+    // Contacts in contact order: a pair each, 1..6 points with distinct features in narrowphase order (not sorted).
+    const int numContacts = round == 0 ? 300 : 40 + int(rng() % 200);  // round 0 leaves the largest storage
+    std::vector<uint64_t> pairs;
+    for (uint64_t p = 5; int(pairs.size()) < numContacts; p += 1 + rng() % 9) pairs.push_back(p);
+    if (!ascending) std::shuffle(pairs.begin(), pairs.end(), rng);
+    std::vector<std::vector<WarmStartCache::Entry>> contacts;
+    for (uint64_t p : pairs) {
+      std::vector<uint32_t> features{0, 1, 2, 3, 4, 5};
+      std::shuffle(features.begin(), features.end(), rng);
+      features.resize(1 + rng() % 6);
+      auto& c = contacts.emplace_back();
+      for (uint32_t f : features)
+        c.push_back({p, f, Real(rng() % 1000) / 7, Vec3(Real(f), 2, 3), Real(round), Vec3(Real(p), Real(f), 0)});
+    }
+    added.beginStore();
+    for (const auto& c : contacts)
+      for (const auto& e : c) added.add(e);
+    added.commit();
+    // In place: the places in contact order, the contacts written in a shuffled order (as two threads would).
+    std::vector<size_t> first;
+    size_t n = 0;
+    for (const auto& c : contacts) {
+      first.push_back(n);
+      n += c.size();
+    }
+    placed.beginStorePlaced(n);
+    std::vector<size_t> writeOrder(contacts.size());
+    for (size_t k = 0; k < writeOrder.size(); ++k) writeOrder[k] = k;
+    std::shuffle(writeOrder.begin(), writeOrder.end(), rng);
+    for (size_t k : writeOrder) {
+      for (size_t j = 0; j < contacts[k].size(); ++j) placed.set(first[k] + j, contacts[k][j]);
+      placed.sortRun(first[k], first[k] + contacts[k].size());
+    }
+    placed.commitPlaced(ascending);
+    int compared = 0;
+    for (uint64_t p : pairs) {
+      const auto want = added.pairRange(p), got = placed.pairRange(p);
+      REQUIRE(got.second - got.first == want.second - want.first);
+      for (auto a = want.first, b = got.first; a != want.second; ++a, ++b) {
+        CHECK(b->feature == a->feature);
+        CHECK(b->normal == a->normal);
+        CHECK(b->point == a->point);
+        CHECK(b->impactSpeed == a->impactSpeed);
+        ++compared;
+      }
+    }
+    CHECK(compared == int(n));
+    // Sorted by pair, then feature: what the row build's ascending lookups need.
+    for (uint64_t p : pairs) {
+      const auto got = placed.pairRange(p);
+      for (auto e = got.first; e + 1 < got.second; ++e) CHECK(e->feature < (e + 1)->feature);
+    }
   }
 }

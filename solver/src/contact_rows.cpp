@@ -454,7 +454,7 @@ void buildContactRows(SimulationState& s) {
           const uint32_t row = uint32_t(s.rows.size()), point = uint32_t(s.pointRows.size()),
                          coupling = uint32_t(s.couplings.size());
           const uint32_t numRows = contactRows<RowMode::APPEND>(s, ci, k, tally[0]).first;
-          layout[ci] = {row, point, coupling, numRows};
+          layout[ci] = {row, point, coupling, numRows, uint32_t(s.pointRows.size()) - point};
         }
         s.rowGroupEnd[g] = uint32_t(s.rows.size());
       }
@@ -476,7 +476,7 @@ void buildContactRows(SimulationState& s) {
         for (const uint32_t ci : s.contactGroups[g]) {
           ContactLayout& l = layout[ci];
           const uint32_t numRows = l.row, numPoints = l.point;
-          l = {row, point, coupling, numRows};
+          l = {row, point, coupling, numRows, numPoints};
           row += numRows;
           point += numPoints;
           coupling += numRows > 0 ? 1 : 0;

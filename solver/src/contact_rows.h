@@ -47,9 +47,11 @@ struct PointRows {
 };
 
 /// Where the parallel row build puts one contact's rows (contact_rows.cpp): its first row, point and coupling,
-/// and its row count (0: not solved).
+/// its row count (0: not solved) and point count; and where the grouped store puts its first warm-start entry
+/// (store_results.cpp: the entries in contact order).
 struct ContactLayout {
   uint32_t row, point, coupling, count;
+  uint32_t points = 0, entry = 0;
 };
 
 /// The row range and solver bodies of one solved contact or constraint (the couplings of the shock order).
@@ -160,6 +162,27 @@ class WarmStartCache {
   /// Collect this step's entries with add(), then commit() makes them the cache the next step reads.
   void beginStore() { next_.clear(); }
   void add(const Entry& e) { next_.push_back(e); }
+  /// The store in place (store_results.cpp, grouped rows): n entries, each written once by set() on any thread,
+  /// each contact's run then ordered by sortRun on the thread that wrote it, and commitPlaced. Last step's
+  /// storage is overwritten, not cleared: clearing would refill it with zeros on the calling thread.
+  void beginStorePlaced(size_t n) { next_.resize(n); }
+  void set(size_t i, const Entry& e) { next_[i] = e; }
+  /// Orders entries [begin, end), one pair's, by feature (stable insertion sort: what commit() does to a pair's run).
+  void sortRun(size_t begin, size_t end) {
+    for (size_t i = begin + 1; i < end; ++i) {
+      if (!(next_[i] < next_[i - 1])) continue;
+      const Entry e = next_[i];
+      size_t j = i;
+      for (; j > begin && e < next_[j - 1]; --j) next_[j] = next_[j - 1];
+      next_[j] = e;
+    }
+  }
+  /// Makes the placed entries the cache. pairsAscending: the runs' pairs strictly ascend (Space::collide sorts its
+  /// contacts by pair), so the sorted runs are sorted entries; otherwise everything is sorted here.
+  void commitPlaced(bool pairsAscending) {
+    if (!pairsAscending) std::sort(next_.begin(), next_.end());
+    std::swap(current_, next_);
+  }
   void commit() {
     // The entries arrive in contact order, which Space::collide sorts by geometry pair, i.e. by the key's first
     // field: only each pair's few points need ordering by feature (insertion sort, stable). std::sort on all 80-

@@ -2,7 +2,10 @@
 // Copyright (c) 2026 The Scree authors
 // Store-results stage: the solved impulses become the contact points' forces and next step's warm start, the
 // constraints' results (Constraint::storeResult) and the particle contacts' forces.
+#include <algorithm>
 #include <cmath>
+
+#include "scree/core/parallel.h"
 
 #include "step_stages.h"
 
@@ -10,14 +13,14 @@ namespace scree::detail {
 
 void storeResults(SimulationState& s) {
   const Real invH = 1.0 / s.h;
-  s.warmStart.beginStore();
   // Next step's warm start: a row's sweeps' impulse when the shock pass recorded one (s.sweepLambda), else its
   // solved impulse (solve_stage.cpp rigidShock says why).
   auto warmLambda = [&s](int32_t i) {
     return size_t(i) < s.sweepLambda.size() && !std::isnan(s.sweepLambda[i]) ? s.sweepLambda[i] : s.rows[i].lambda;
   };
-  // Inlined into both loops below: called, it cost pyramid20's store about 12 % more instructions.
-  auto store = [&](const PointRows& pr) __attribute__((always_inline)) {
+  // Inlined into the loops below: called, it cost pyramid20's store about 12 % more instructions. `put` takes the
+  // point's warm-start entry.
+  auto store = [&](const PointRows& pr, auto&& put) __attribute__((always_inline)) {
     GeometryContact& c = s.contacts[pr.contact];
     ContactPoint& p = c.points()[pr.point];
     const Real ln = s.rows[pr.normal].lambda;
@@ -32,19 +35,54 @@ void storeResults(SimulationState& s) {
     Vec3 fw = Vec3::Zero();
     if (pr.t1 >= 0) fw = warmLambda(pr.t1) * pr.tangent1 + warmLambda(pr.t1 + 1) * pr.tangent2;
     if (pr.twist >= 0) fw = pr.share * fw + warmLambda(pr.twist) * pr.twistArm;
-    s.warmStart.add({contactPairKey(c), p.featureId, warmLambda(pr.normal), fw, pr.impactSpeed, p.point});
+    put(WarmStartCache::Entry{contactPairKey(c), p.featureId, warmLambda(pr.normal), fw, pr.impactSpeed, p.point});
   };
-  // In contact order, which is the warm-start cache's pair order (WarmStartCache::commit sorts anything else): the
-  // grouped row build (contact_rows.cpp) lays the points out by region, and each contact's points are together.
   if (s.rowGroupsReady) {
-    for (uint32_t ci = 0; ci < s.contacts.size(); ++ci)
-      if (s.contactLayout[ci].count > 0)
-        for (uint32_t j = s.contactLayout[ci].point; j < s.pointRows.size() && s.pointRows[j].contact == ci; ++j)
-          store(s.pointRows[j]);
+    // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "Each thread lays out and takes down its
+    // region"): with the rows laid out by region (contact_rows.cpp), each group's contacts are stored on the
+    // thread that built, prepared and swept their rows, so the rows' impulses are read where they were written
+    // (on the program thread they crossed between the cores, and the next step's row build had to take the lines
+    // back). The entries keep the cache's order, contact order: each contact's entries go to the place the
+    // contacts before it leave free, and each contact's run is ordered by feature on its thread. Same entries in
+    // the same places on any thread count.
+    auto& layout = s.contactLayout;
+    uint32_t entries = 0;
+    uint64_t lastPair = 0;
+    bool ascending = true, firstPair = true;
+    for (uint32_t ci = 0; ci < s.contacts.size(); ++ci) {
+      ContactLayout& l = layout[ci];
+      if (l.count == 0) continue;
+      l.entry = entries;
+      entries += l.points;
+      const uint64_t pair = contactPairKey(s.contacts[ci]);
+      ascending = ascending && (firstPair || pair > lastPair);
+      lastPair = pair;
+      firstPair = false;
+    }
+    s.warmStart.beginStorePlaced(entries);
+    constexpr int G = PgsPartition::kRegions + 1;
+    const int threads = s.rowGroupThreads;
+    int ran = threads;
+    runTeam(threads, [&](int t, int n) {
+      if (t == 0) ran = std::min(ran, n);
+      for (int g = 0; g < G; ++g) {
+        if ((g < PgsPartition::kRegions ? g % n : 0) != t) continue;  // the row build's owners
+        for (const uint32_t ci : s.contactGroups[g]) {
+          const ContactLayout& l = layout[ci];
+          if (l.count == 0) continue;
+          for (uint32_t k = 0; k < l.points; ++k)
+            store(s.pointRows[l.point + k], [&](const WarmStartCache::Entry& e) { s.warmStart.set(l.entry + k, e); });
+          s.warmStart.sortRun(l.entry, l.entry + l.points);
+        }
+      }
+    });
+    s.rowBuildTeamBusy = s.rowBuildTeamBusy || ran < threads;
+    s.warmStart.commitPlaced(ascending);
   } else {
-    for (const PointRows& pr : s.pointRows) store(pr);
+    s.warmStart.beginStore();
+    for (const PointRows& pr : s.pointRows) store(pr, [&](const WarmStartCache::Entry& e) { s.warmStart.add(e); });
+    s.warmStart.commit();
   }
-  s.warmStart.commit();
   storeFrictionAnchors(s);  // issue 18 (friction anchors, friction_anchor.h): keep the anchors that stick
   for (const auto& r : s.ranges) r.c->storeResult(s.rows.data() + r.begin, s.rowDofs.data() + r.begin, r.count, s.h);
   if (s.granularStep) {
