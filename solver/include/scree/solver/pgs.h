@@ -122,7 +122,8 @@ struct PgsBlocks {
   std::vector<Unit> plan;
   /// Per ConstraintRow: the record whose rows start there, or -1; filled only when the records are not in row
   /// order (the partitioned sweeps lay them out region by region), empty otherwise (the records are then
-  /// searched by row). Records with n < 0 are gaps between regions, never visited.
+  /// searched by row). Records with n < 0 are never visited: the gaps between regions and, in the partitioned
+  /// layout (one record per unit), the records of units that are no compact manifold.
   std::vector<int32_t> rowManifold;
 };
 
