@@ -837,9 +837,11 @@ void updateSums(PgsBlocks::Manifold& m, const PgsBlocks::Point* P) {
 }
 
 /// Writes the compact record m of the manifold contact whose rows start at row i (n normal rows; isCompactManifold
-/// and fitsCompactLayout hold), its points at pb.points[point, point + n) (already sized).
+/// and fitsCompactLayout hold), its points from pb.points[point] on, each through putPoint(k, point) (which
+/// appends or writes in place).
+template <class PutPoint>
 void writeCompact(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
-                  PgsBlocks& pb, PgsBlocks::Manifold& m, uint32_t point, size_t i, int n) {
+                  PgsBlocks& pb, PgsBlocks::Manifold& m, uint32_t point, size_t i, int n, PutPoint&& putPoint) {
   const ConstraintRow& t1 = rows[i];
   m.a = t1.bodyA;
   m.b = t1.bodyB;
@@ -876,7 +878,7 @@ void writeCompact(const std::vector<ConstraintRow>& rows, const std::vector<Solv
   m.axisV = B.axisV;
   for (int k = 0; k < n; ++k) {
     const ConstraintRow& r = rows[i + 3 + size_t(k)];
-    pb.points[point + uint32_t(k)] = {r.blockU, r.blockV, r.e, r.lambda, r.lo};
+    putPoint(k, PgsBlocks::Point{r.blockU, r.blockV, r.e, r.lambda, r.lo});
   }
   updateSums(m, pb.points.data() + m.point);
 }
@@ -884,9 +886,8 @@ void writeCompact(const std::vector<ConstraintRow>& rows, const std::vector<Solv
 /// Appends the compact record of the manifold contact whose rows start at row i (writeCompact).
 void appendCompact(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
                    PgsBlocks& pb, size_t i, int n) {
-  const uint32_t point = uint32_t(pb.points.size());
-  pb.points.resize(pb.points.size() + size_t(n));
-  writeCompact(rows, bodies, pb, pb.manifolds.emplace_back(), point, i, n);
+  writeCompact(rows, bodies, pb, pb.manifolds.emplace_back(), uint32_t(pb.points.size()), i, n,
+               [&pb](int, const PgsBlocks::Point& q) { pb.points.push_back(q); });
 }
 
 /// Writes the impulses of record m back into its rows.
@@ -1817,7 +1818,8 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
         p.unitManifold[u] = record;
         pb.rowManifold[i] = record;
         PgsBlocks::Manifold& m = pb.manifolds[size_t(record)];
-        writeCompact(rows, bodies, pb, m, point, i, n);
+        writeCompact(rows, bodies, pb, m, point, i, n,
+                     [&pb, point](int k, const PgsBlocks::Point& q) { pb.points[point + uint32_t(k)] = q; });
         point += uint32_t(n);
         if (m.a >= 0 && size_t(m.a) < nb) m.a = p.localOf[view + size_t(m.a)];
         if (m.b >= 0 && size_t(m.b) < nb) m.b = p.localOf[view + size_t(m.b)];

@@ -18,9 +18,9 @@ void storeResults(SimulationState& s) {
   auto warmLambda = [&s](int32_t i) {
     return size_t(i) < s.sweepLambda.size() && !std::isnan(s.sweepLambda[i]) ? s.sweepLambda[i] : s.rows[i].lambda;
   };
-  // Inlined into the loops below: called, it cost pyramid20's store about 12 % more instructions. `put` takes the
+  // Inlined into the loops below: called, it cost pyramid20's store about 12 % more instructions. Returns the
   // point's warm-start entry.
-  auto store = [&](const PointRows& pr, auto&& put) __attribute__((always_inline)) {
+  auto store = [&](const PointRows& pr) __attribute__((always_inline)) {
     GeometryContact& c = s.contacts[pr.contact];
     ContactPoint& p = c.points()[pr.point];
     const Real ln = s.rows[pr.normal].lambda;
@@ -35,7 +35,7 @@ void storeResults(SimulationState& s) {
     Vec3 fw = Vec3::Zero();
     if (pr.t1 >= 0) fw = warmLambda(pr.t1) * pr.tangent1 + warmLambda(pr.t1 + 1) * pr.tangent2;
     if (pr.twist >= 0) fw = pr.share * fw + warmLambda(pr.twist) * pr.twistArm;
-    put(WarmStartCache::Entry{contactPairKey(c), p.featureId, warmLambda(pr.normal), fw, pr.impactSpeed, p.point});
+    return WarmStartCache::Entry{contactPairKey(c), p.featureId, warmLambda(pr.normal), fw, pr.impactSpeed, p.point};
   };
   if (s.rowGroupsReady) {
     // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "Each thread lays out and takes down its
@@ -71,7 +71,7 @@ void storeResults(SimulationState& s) {
           const ContactLayout& l = layout[ci];
           if (l.count == 0) continue;
           for (uint32_t k = 0; k < l.points; ++k)
-            store(s.pointRows[l.point + k], [&](const WarmStartCache::Entry& e) { s.warmStart.set(l.entry + k, e); });
+            s.warmStart.set(l.entry + k, store(s.pointRows[l.point + k]));
           s.warmStart.sortRun(l.entry, l.entry + l.points);
         }
       }
@@ -80,7 +80,7 @@ void storeResults(SimulationState& s) {
     s.warmStart.commitPlaced(ascending);
   } else {
     s.warmStart.beginStore();
-    for (const PointRows& pr : s.pointRows) store(pr, [&](const WarmStartCache::Entry& e) { s.warmStart.add(e); });
+    for (const PointRows& pr : s.pointRows) s.warmStart.add(store(pr));
     s.warmStart.commit();
   }
   storeFrictionAnchors(s);  // issue 18 (friction anchors, friction_anchor.h): keep the anchors that stick
