@@ -214,7 +214,7 @@ TEST_CASE("partitioned sweeps: pyramid20 is bit-identical on 1 and 2 threads, wi
   // An odd count of sweeps: the last one is forward and ends with the boundary, which moves the regions' bodies in
   // the sweeps' local layout after the regions are done. Each thread writes its region's bodies back only after
   // that (pgs.cpp PgsSolver::iterate, the take-down's barrier); written earlier, the boundary's last impulses
-  // would be lost on two threads only (and ThreadSanitizer, CI stage f, reports the race).
+  // would be lost on two threads only (a data race too: CI stage f runs this case under ThreadSanitizer).
   const auto [oddOne, o1] = runPartitioned(1, false, 60, nullptr, 9);
   const auto [oddTwo, o2] = runPartitioned(2, false, 60, nullptr, 9);
   REQUIRE(oddOne.size() == oddTwo.size());
