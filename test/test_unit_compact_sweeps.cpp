@@ -257,6 +257,116 @@ TEST_CASE("partitioned sweeps on their own body layout give the serial sweeps' b
   CHECK(R == 2);
 }
 
+// The boundary by colour (pgs_partition.cpp colourBoundary, pgs.cpp PgsSolver::iterate): a zigzag column of 24
+// boxes, L0 R0 L1 R1 ... (L_j body j at x = -0.5, R_j body 12 + j at x = +0.5, each resting on the one before it,
+// the manifold centred on x = 0), so every manifold of the column joins the two regions, like the column of
+// contacts on pyramid20's cut. Each box also carries two free rows (units of one body), so that the scene has the
+// 64 units the partitioned sweeps need for two threads. First fit in the serial order gives the column's manifolds
+// colours 0, 1, 0, 1, ...: 12 and 11 units.
+TEST_CASE("partitioned sweeps: the boundary by colour, both threads sweeping each colour, the bits of one thread") {
+  constexpr int kPerSide = 12, nb = 2 * kPerSide;
+  std::vector<SolverBodyState> bodies(nb);
+  std::vector<Vec3> centre(nb);
+  PgsPartition proto;
+  proto.bodyPosition.assign(nb, Vec3::Zero());
+  for (int j = 0; j < kPerSide; ++j) {
+    centre[size_t(j)] = Vec3(-0.5, 0, 0.5 + 2 * j);
+    centre[size_t(kPerSide + j)] = Vec3(0.5, 0, 1.5 + 2 * j);
+    // Only x differs: y and z tie, and a tie in a coordinate falls back on the body index, which gives the same
+    // cut; the lowest axis wins the tie.
+    proto.bodyPosition[size_t(j)] = Vec3(-0.5, 0, 0);
+    proto.bodyPosition[size_t(kPerSide + j)] = Vec3(0.5, 0, 0);
+  }
+  for (int i = 0; i < nb; ++i) {
+    bodies[size_t(i)].invMass = 1.0 / (1.0 + 0.1 * i);
+    bodies[size_t(i)].invInertia = Mat3(Vec3(3.0, 2.0 + 0.05 * i, 2.5).asDiagonal());
+    bodies[size_t(i)].v = Vec3(0.01 * (i % 5), -0.02 * (i % 3), -0.3 - 0.01 * i);
+    bodies[size_t(i)].w = Vec3(0.02 * (i % 4), 0.01 * (i % 7), 0);
+  }
+  std::vector<ConstraintRow> rows;
+  auto unit = [&](int begin) { proto.units.push_back({uint32_t(begin), uint32_t(rows.size()) - uint32_t(begin)}); };
+  // The column in the serial order: R_j on L_j, then L_{j+1} on R_j.
+  for (int k = 0; k + 1 < nb; ++k) {
+    const int lower = k % 2 == 0 ? k / 2 : kPerSide + k / 2, upper = k % 2 == 0 ? kPerSide + k / 2 : k / 2 + 1;
+    const Vec3 mid(0, 0, 1.0 + Real(k));
+    const int m = addManifold(rows, upper, lower, centre[size_t(upper)], centre[size_t(lower)], mid, 0.3, 0.5);
+    for (int i = 0; i < 4; ++i) rows[size_t(m + 3 + i)].lambda = 1.0 + 0.1 * ((k + i) % 5);
+    unit(m);
+  }
+  for (int i = 0; i < nb; ++i)
+    for (int k = 0; k < 2; ++k) {
+      ConstraintRow r;
+      r.bodyA = i;
+      r.jLinA = k == 0 ? Vec3(0.3, 1, 0).normalized() : Vec3(0, 0.6, 0.8);
+      r.jAngA = Vec3(0, 0, 1);
+      r.rhs = 0.05 * (k + 1);
+      r.e = 1e-4;
+      r.lo = -1;
+      r.hi = 1;
+      const int begin = int(rows.size());
+      rows.push_back(r);
+      unit(begin);
+    }
+  REQUIRE(proto.units.size() >= 64);
+
+  constexpr int R = PgsPartition::kRegions;
+  setNumThreads(2);
+  const bool twoThreads = getNumThreads() == 2;
+  WARN_MESSAGE(twoThreads, "built without OpenMP: the 2-thread run used one thread");
+  for (const int iterations : {10, 9}) {  // 9: the last sweep is forward and ends with the boundary's last colour
+    CAPTURE(iterations);
+    std::vector<ConstraintRow> rowsRun[2];
+    std::vector<SolverBodyState> bodiesRun[2];
+    Real delta[2] = {};
+    for (int threads = 1; threads <= 2; ++threads) {
+      setNumThreads(threads);
+      std::vector<ConstraintRow> rs = rows;
+      std::vector<SolverBodyState> bs = bodies;
+      PgsPartition p = proto;
+      PgsBlocks blocks;
+      PgsSolver::prepare(rs, bs, &blocks);
+      PgsSolver::partition(rs, bs, p);
+      // The cut runs between the sides, so the whole column is the boundary, in two colours.
+      REQUIRE(p.axis == 0);
+      for (int i = 0; i < nb; ++i) REQUIRE(p.bodyRegion[size_t(i)] == (i < kPerSide ? 0 : 1));
+      REQUIRE(p.split[R + 1] - p.split[R] == uint32_t(nb - 1));
+      REQUIRE(p.boundaryColours == 2);
+      CHECK(p.boundarySplit[0] == p.split[R]);
+      CHECK(p.boundarySplit[1] - p.boundarySplit[0] == 12);
+      CHECK(p.boundarySplit[2] == p.split[R + 1]);
+      for (int c = 0; c < p.boundaryColours; ++c) {
+        std::vector<int> seen(nb, 0);
+        for (uint32_t u = p.boundarySplit[c]; u < p.boundarySplit[c + 1]; ++u) {
+          const ConstraintRow& r = rs[p.order[u].begin];
+          CHECK(++seen[size_t(r.bodyA)] == 1);  // no two units of a colour share a body
+          CHECK(++seen[size_t(r.bodyB)] == 1);
+          if (u > p.boundarySplit[c]) CHECK(p.order[u - 1].begin < p.order[u].begin);  // serial order kept
+        }
+      }
+      CHECK(std::all_of(p.colourMask.begin(), p.colourMask.end(), [](uint8_t m) { return m == 0; }));
+      delta[threads - 1] = PgsSolver::iterate(rs, bs, iterations, &blocks, p);
+      rowsRun[threads - 1] = rs;
+      bodiesRun[threads - 1] = bs;
+    }
+    // Bit for bit: the units of a colour share no body, so the threads' halves of a colour commute.
+    CHECK(delta[0] == delta[1]);
+    for (size_t i = 0; i < rows.size(); ++i) {
+      CAPTURE(i);
+      CHECK(std::memcmp(&rowsRun[0][i].lambda, &rowsRun[1][i].lambda, sizeof(Real)) == 0);
+      CHECK(rowsRun[1][i].bodyA == rows[i].bodyA);  // the rows point at the shared bodies again
+    }
+    for (int b = 0; b < nb; ++b) {
+      CAPTURE(b);
+      CHECK(bodiesRun[0][size_t(b)].v == bodiesRun[1][size_t(b)].v);
+      CHECK(bodiesRun[0][size_t(b)].w == bodiesRun[1][size_t(b)].w);
+      CHECK(bodiesRun[1][size_t(b)].v.allFinite());
+    }
+    // The sweeps moved the column (else the comparison would be empty).
+    CHECK((bodiesRun[0][0].v - bodies[0].v).norm() > 1e-3);
+  }
+  setNumThreads(1);
+}
+
 // Largest |lambda| of the rows and the largest difference between two runs' impulses and velocities.
 void compareRuns(const std::vector<ConstraintRow>& rowsD, const std::vector<ConstraintRow>& rowsP,
                  const std::vector<SolverBodyState>& bodiesD, const std::vector<SolverBodyState>& bodiesP) {

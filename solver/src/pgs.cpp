@@ -1785,6 +1785,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   const size_t nu = p.order.size();
   p.unitManifold.assign(nu, -1);
   uint32_t pointBase[R + 2] = {};
+  auto unitPoints = [](const PgsPartition::Unit& un) { return un.count >= 5 ? un.count - 3 : 0u; };
   if (blocks) {
     PgsBlocks& pb = *blocks;
     pb.plan.clear();
@@ -1792,8 +1793,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
     pb.manifolds.resize(nu + R + 1);
     for (int g = 0; g <= R; ++g) {
       uint32_t points = 0;
-      for (uint32_t u = split[g]; u < split[g + 1]; ++u)
-        if (p.order[u].count >= 5) points += p.order[u].count - 3;
+      for (uint32_t u = split[g]; u < split[g + 1]; ++u) points += unitPoints(p.order[u]);
       pointBase[g + 1] = pointBase[g] + points + kGapPoints;
       pb.manifolds[split[g + 1] + uint32_t(g)].n = -1;  // the gap after group g, never visited
     }
@@ -1806,10 +1806,12 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   // Stop 45 and before, the program thread read every row to lay out the records and wrote every row's impulse
   // back, so the second region's rows crossed between the cores twice per step. Same operations on the same data
   // in the same order per record and per body, so the same bits on any thread count.
-  auto layOut = [&](int g) {
+  // Units [first, last) of group g; their points follow the units of the group before them.
+  auto layOut = [&](int g, uint32_t first, uint32_t last) {
     const size_t view = size_t(g < R ? g : 0) * nb;
     uint32_t point = pointBase[g];
-    for (uint32_t u = split[g]; u < split[g + 1]; ++u) {
+    for (uint32_t u = split[g]; u < first; ++u) point += unitPoints(p.order[u]);
+    for (uint32_t u = first; u < last; ++u) {
       const uint32_t i = p.order[u].begin;
       int n = 0;
       if (blocks && compactUnit(rows, *blocks, i, n) && 3 + uint32_t(n) == p.order[u].count) {
@@ -1826,7 +1828,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
         continue;
       }
       if (blocks) blocks->manifolds[u + uint32_t(g)].n = -1;
-      if (p.order[u].count >= 5) point += p.order[u].count - 3;
+      point += unitPoints(p.order[u]);
       // Swept as ConstraintRows: a deferred normal block's rows are prepared first, on the shared bodies; then the
       // rows index the local layout until the end of the sweeps (a compact record's rows keep the shared
       // indices: compactBlock's fallback maps them for its call).
@@ -1840,8 +1842,8 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   auto toShared = [&](int32_t& b) {
     if (b >= 0 && size_t(b) < p.globalOf.size()) b = p.globalOf[size_t(b)];
   };
-  auto takeDown = [&](int g) {
-    for (uint32_t u = split[g]; u < split[g + 1]; ++u) {
+  auto takeDown = [&](uint32_t first, uint32_t last) {
+    for (uint32_t u = first; u < last; ++u) {
       if (p.unitManifold[u] >= 0) {
         PgsBlocks::Manifold& m = blocks->manifolds[size_t(p.unitManifold[u])];
         writeBackRecord(rows, *blocks, m);
@@ -1864,40 +1866,78 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   TeamBarrier barrier(threads);
   runTeam(threads, [&](int t, int nt) {
     if (nt < threads) p.teamBusy = true;  // only the calling thread runs then (nt == 1)
-    auto owns = [&](int g) { return (g < R ? g % nt : 0) == t; };  // the boundary's group is thread 0's
+    auto owns = [&](int g) { return g % nt == t; };
+    // The boundary's units of this thread: with colours and two threads, per colour (PgsPartition::boundaryColours)
+    // the first half of its units for thread 0 and the rest for thread 1; else all of them for thread 0. The
+    // boundary is sorted by colour, so one thread sweeping it whole keeps the same order.
+    const int phases = p.boundaryColours > 0 && nt > 1 ? p.boundaryColours : 1;
+    auto boundaryShare = [&](int c, uint32_t& first, uint32_t& last) {
+      first = last = split[R];
+      if (phases == 1) {
+        if (t == 0) last = split[R + 1];
+        return;
+      }
+      const uint32_t cb = p.boundarySplit[c], ce = p.boundarySplit[c + 1], mid = cb + (ce - cb + 1) / 2;
+      first = t == 0 ? cb : mid;
+      last = t == 0 ? mid : ce;
+    };
     // Lay out: this thread's regions' local bodies, then its groups' records and rows. The boundary's first
     // visit comes after the first sweep's barrier, when the other region's local bodies are in place.
     for (int g = 0; g < R; ++g)
       if (owns(g))
         for (size_t k = slots[g]; k < slots[g + 1]; ++k)
           lb[k] = p.globalOf[k] >= 0 ? bodies[size_t(p.globalOf[k])] : SolverBodyState{};
-    for (int g = 0; g <= R; ++g)
-      if (owns(g)) layOut(g);
+    for (int g = 0; g < R; ++g)
+      if (owns(g)) layOut(g, split[g], split[g + 1]);
+    for (int c = 0; c < phases; ++c) {
+      uint32_t first, last;
+      boundaryShare(c, first, last);
+      layOut(R, first, last);
+    }
     Real local = 0;
     auto regions = [&](bool forward) {
       for (int g = 0; g < R; ++g)
         if (owns(g))
           local = std::max(local, sweepUnits(rows, lb, order, manifold, split[g], split[g + 1], forward, blocks));
     };
-    auto boundaryUnits = [&](bool forward) {
-      if (t == 0)
-        local = std::max(local, sweepUnits(rows, lb, order, manifold, split[R], split[R + 1], forward, blocks));
+    auto boundaryUnits = [&](int c, bool forward) {
+      uint32_t first, last;
+      boundaryShare(c, first, last);
+      if (first < last) local = std::max(local, sweepUnits(rows, lb, order, manifold, first, last, forward, blocks));
     };
+    // A forward sweep: the regions, then the boundary colour by colour; a backward sweep the reverse. The last
+    // colour of a forward sweep and the first of the next backward sweep are the same units on the same threads,
+    // so no barrier between them.
     for (int it = 0; it < iterations; ++it) {
       const bool forward = it % 2 == 0;
       local = 0;
-      if (forward) regions(true);
-      else boundaryUnits(false);
-      if (boundary && nt > 1) barrier.wait();
-      if (forward) boundaryUnits(true);
-      else regions(false);
+      if (forward) {
+        regions(true);
+        if (boundary && nt > 1) barrier.wait();
+        for (int c = 0; c < phases; ++c) {
+          if (c > 0) barrier.wait();
+          boundaryUnits(c, true);
+        }
+      } else {
+        for (int c = phases; c-- > 0;) {
+          boundaryUnits(c, false);
+          if (c > 0) barrier.wait();
+        }
+        if (boundary && nt > 1) barrier.wait();
+        regions(false);
+      }
     }
     if (t < R) lastSweep[t] = local;
     // Take down: the groups' impulses and indices (no other thread reads them), then, once the boundary's last
     // sweep is over (a forward sweep ends with it), the regions' movable bodies (the static copies changed
     // nothing).
-    for (int g = 0; g <= R; ++g)
-      if (owns(g)) takeDown(g);
+    for (int g = 0; g < R; ++g)
+      if (owns(g)) takeDown(split[g], split[g + 1]);
+    for (int c = 0; c < phases; ++c) {
+      uint32_t first, last;
+      boundaryShare(c, first, last);
+      takeDown(first, last);
+    }
     if (boundary && nt > 1 && iterations > 0 && (iterations - 1) % 2 == 0) barrier.wait();
     for (int g = 0; g < R; ++g)
       if (owns(g))

@@ -19,6 +19,7 @@
 //    body index), never on the thread count; within each group the units keep the serial sweep's order.
 //  - Cost: three sorts of the movable bodies per step (pyramid20: 210 bodies), storage reused across steps.
 #include <algorithm>
+#include <bit>
 
 #include "scree/solver/pgs.h"
 
@@ -81,6 +82,71 @@ void PgsSolver::partition(const std::vector<ConstraintRow>& rows, const std::vec
   for (int g = 0; g <= R; ++g) next[g] = p.split[g];
   p.order.resize(nu);
   for (size_t u = 0; u < nu; ++u) p.order[next[p.unitGroup[u]]++] = p.units[u];
+  colourBoundary(rows, bodies, p);
+}
+
+// DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "The boundary swept by both threads"): until
+// then thread 0 swept the whole boundary while thread 1 waited. The boundary's units couple a body of each region,
+// so half of its bodies sit in the other thread's cache: per row it cost pyramid20 about three times a region's
+// row (perf), and it was about a quarter of thread 1's waits. Units of one colour share no movable body (a boundary
+// unit has two movable bodies and no static one), so their order within the colour does not change the result:
+// each thread sweeps half of every colour, with a barrier between colours. The serial order becomes colour by
+// colour (first fit in the serial order), on one thread as on two, so the bits stay independent of the thread
+// count. Colouring costs two barriers per pair of sweeps and colour; it is used only when each colour has units
+// enough to pay for them.
+void PgsSolver::colourBoundary(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                               PgsPartition& p) {
+  constexpr int R = PgsPartition::kRegions;
+  constexpr int kMinUnitsPerColour = 4;
+  constexpr int C = PgsPartition::kMaxBoundaryColours;
+  const uint32_t first = p.split[R], last = p.split[R + 1];
+  p.boundaryColours = 0;
+  if (last - first < uint32_t(2 * kMinUnitsPerColour)) return;
+  if (p.colourMask.size() < std::max(bodies.size(), p.bodyRegion.size()))
+    p.colourMask.resize(std::max(bodies.size(), p.bodyRegion.size()), 0);
+  p.unitColour.resize(last - first);
+  uint32_t count[C] = {};
+  bool fits = true;
+  for (uint32_t u = first; u < last; ++u) {
+    // Only units of two bodies the regions hold: a static or kinematic body has a private copy per view, which
+    // two threads must not both write, and a body the kept cut did not see is local to the boundary's view.
+    const ConstraintRow& r = p.order[u].count > 0 ? rows[p.order[u].begin] : rows.front();
+    const int32_t b[2] = {r.bodyA, r.bodyB};
+    bool held = p.order[u].count > 0;
+    for (const int32_t x : b) held = held && x >= 0 && size_t(x) < p.bodyRegion.size() && p.bodyRegion[size_t(x)] >= 0;
+    if (!held) {
+      fits = false;
+      break;
+    }
+    const uint8_t used = uint8_t(p.colourMask[size_t(b[0])] | p.colourMask[size_t(b[1])]);
+    const int c = std::countr_one(unsigned(used));
+    if (c >= C) {
+      fits = false;
+      break;
+    }
+    for (const int32_t x : b) p.colourMask[size_t(x)] |= uint8_t(1u << c);
+    p.unitColour[u - first] = uint8_t(c);
+    ++count[c];
+  }
+  for (uint32_t u = first; u < last; ++u) {  // the mask back to zero
+    if (p.order[u].count == 0) continue;
+    const ConstraintRow& r = rows[p.order[u].begin];
+    for (const int32_t x : {r.bodyA, r.bodyB})
+      if (x >= 0 && size_t(x) < p.colourMask.size()) p.colourMask[size_t(x)] = 0;
+  }
+  if (!fits) return;
+  int colours = 0;
+  while (colours < C && count[colours] > 0) ++colours;
+  for (int c = 0; c < colours; ++c)
+    if (count[c] < uint32_t(kMinUnitsPerColour)) return;
+  // Stable sort by colour.
+  p.boundarySplit[0] = first;
+  for (int c = 0; c < colours; ++c) p.boundarySplit[c + 1] = p.boundarySplit[c] + count[c];
+  uint32_t next[C];
+  for (int c = 0; c < colours; ++c) next[c] = p.boundarySplit[c];
+  p.unitScratch.assign(p.order.begin() + first, p.order.begin() + last);
+  for (uint32_t u = first; u < last; ++u) p.order[next[p.unitColour[u - first]]++] = p.unitScratch[u - first];
+  p.boundaryColours = colours;
 }
 
 void PgsSolver::cutRegions(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
