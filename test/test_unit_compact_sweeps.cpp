@@ -389,7 +389,7 @@ TEST_CASE("normal rows prepared on first use give the prepared rows' sweeps, fal
   // PgsSolver::prepare with deferBlockRows leaves the normal blocks' rows without M^-1 J^T (pgs.cpp, "deferred
   // block rows"): the warm start is applied per body, and the paths that read the rows prepare them first.
   const TippingStack scene(true);
-  const PgsSolver::ShockRange m0{uint32_t(scene.m0), 7, 1}, m1{uint32_t(scene.m1), 7, 1};
+  const PgsSolver::ShockRange m0{uint32_t(scene.m0), 7, 1, 0, -1}, m1{uint32_t(scene.m1), 7, 1, 1, 0};
 
   SUBCASE("the sweeps, with the tipping box's bound-hit fallback") {
     std::vector<ConstraintRow> rowsD = scene.rows, rowsP = scene.rows;

@@ -1554,9 +1554,21 @@ void PgsSolver::shockRange(std::vector<ConstraintRow>& rows, std::vector<SolverB
   }
 }
 
+namespace {
+inline void recordRange(const std::vector<ConstraintRow>& rows, const PgsSolver::ShockRange& sr,
+                        const PgsSolver::ShockRecord& record) {
+  if (!record.lambda || sr.begin >= record.end) return;
+  for (uint32_t i = sr.begin; i < sr.begin + sr.count; ++i) record.lambda[i] = rows[i].lambda;
+}
+}  // namespace
+
 void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
-                          const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks) {
-  for (const ShockRange& sr : ranges) shockRange(rows, bodies, sr, maxSweeps, blocks);
+                          const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks,
+                          const ShockRecord& record) {
+  for (const ShockRange& sr : ranges) {
+    recordRange(rows, sr, record);
+    shockRange(rows, bodies, sr, maxSweeps, blocks);
+  }
 }
 
 // ---- issue 18 (sweep scheduling): graph-coloured sweeps (pgs.h PgsColouring) ----
@@ -1958,11 +1970,11 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
 // pass shows it: the result is the serial shockPass's, bit for bit, on any number of threads.
 void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                           const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks,
-                          PgsPartition& p) {
+                          PgsPartition& p, const ShockRecord& record) {
   constexpr int R = PgsPartition::kRegions;
   const int threads = partitionThreads(ranges.size() >= 16, p);
   if (threads < 2) {
-    shockPass(rows, bodies, ranges, maxSweeps, blocks);
+    shockPass(rows, bodies, ranges, maxSweeps, blocks, record);
     return;
   }
   const size_t nb = bodies.size();
@@ -1976,8 +1988,7 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
   p.shockDone.assign(nb, 0);
   for (uint32_t k = 0; k < ranges.size(); ++k) {
     const ShockRange& sr = ranges[k];
-    const ConstraintRow& r0 = rows[sr.begin];
-    const int32_t freeB = sr.frozen == 0 ? r0.bodyB : r0.bodyA, frozenB = sr.frozen == 0 ? r0.bodyA : r0.bodyB;
+    const int32_t freeB = sr.freeBody, frozenB = sr.frozenBody;
     const int l = listOf(freeB);
     uint32_t wait = 0;
     if (frozenB >= 0 && size_t(frozenB) < nb && listOf(frozenB) != l) wait = p.shockDone[size_t(frozenB)];
@@ -1993,12 +2004,13 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
     if (nt < R) {
       // Fewer threads than lists (the team was busy): the serial pass (the same bits).
       p.teamBusy = true;  // only the calling thread runs then (nt == 1)
-      if (t == 0) shockPass(rows, bodies, ranges, maxSweeps, blocks);
+      if (t == 0) shockPass(rows, bodies, ranges, maxSweeps, blocks, record);
     } else if (t < R) {
       const int other = 1 - t;
       const std::vector<uint32_t>& list = p.shockList[t];
       const std::vector<uint32_t>& wait = p.shockWait[t];
       for (size_t j = 0; j < list.size(); ++j) {
+        recordRange(rows, ranges[list[j]], record);  // its own rows: no wait needed
         waitAtLeast(done[other].v, wait[j]);
         shockRange(rows, bodies, ranges[list[j]], maxSweeps, blocks);
         publish(done[t].v, uint32_t(j + 1));

@@ -86,7 +86,8 @@ void buildShockOrder(SimulationState& s) {
   for (const auto& [lvl, k] : s.orderSorted) {
     const auto& c = s.couplings[k];
     const int la = c.ia >= 0 ? s.level[c.ia] : 0, lb = c.ib >= 0 ? s.level[c.ib] : 0;
-    s.shock.push_back({c.begin, c.count, la < lb ? 0 : 1});
+    const int frozen = la < lb ? 0 : 1;
+    s.shock.push_back({c.begin, c.count, frozen, frozen == 0 ? c.ib : c.ia, frozen == 0 ? c.ia : c.ib});
   }
 }
 

@@ -106,22 +106,20 @@ void rigidShock(SimulationState& s, bool onlyIterative) {
   // multi-support contacts start from the sweeps' impulses alone. Joints are left as they were (their warm
   // start is Constraint::storeResult's). Reported contact forces are the solved impulses, shock pass included.
   s.sweepLambda.assign(s.rows.size(), std::numeric_limits<Real>::quiet_NaN());
-  auto freeBody = [&s](const PgsSolver::ShockRange& r) {
-    return r.frozen == 0 ? s.rows[r.begin].bodyB : s.rows[r.begin].bodyA;
-  };
+  auto freeBody = [](const PgsSolver::ShockRange& r) { return r.freeBody; };
   s.shockSupports.assign(s.sb.size(), 0);
   for (const PgsSolver::ShockRange& r : sh)
     if (freeBody(r) >= 0) ++s.shockSupports[freeBody(r)];
   uint32_t contactEnd = uint32_t(s.rows.size());  // contact rows come first, then constraint rows
   for (const auto& cr : s.ranges) contactEnd = std::min(contactEnd, cr.begin);
-  for (const PgsSolver::ShockRange& r : sh) {
-    if (r.begin >= contactEnd) continue;
-    for (uint32_t i = r.begin; i < r.begin + r.count; ++i) s.sweepLambda[i] = s.rows[i].lambda;
-  }
+  // The sweeps' impulses of the contact supports are recorded by the pass, on the thread that solves each range
+  // (issue 18, two-thread scaling): read here, on the program thread, they pulled every row of the second region
+  // into this core's cache just before the second thread wrote them again.
+  const PgsSolver::ShockRecord record{s.sweepLambda.data(), contactEnd};
   if (s.partitionReady)  // issue 18 (sweep scheduling): the same pass, each region's supports on its own thread
-    PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations(), &s.pgsBlocks, s.partition);
+    PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations(), &s.pgsBlocks, s.partition, record);
   else
-    PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations(), &s.pgsBlocks);
+    PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations(), &s.pgsBlocks, record);
   for (const PgsSolver::ShockRange& r : sh) {
     if (r.begin >= contactEnd || (freeBody(r) >= 0 && s.shockSupports[freeBody(r)] > 1)) continue;
     Real added = 0;

@@ -268,10 +268,20 @@ class PgsSolver {
   static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
                       const std::vector<uint32_t>& subset);
 
-  /// A row range whose body `frozen` (0 = A, 1 = B) is held immovable in the shock-propagation pass.
+  /// A row range whose body `frozen` (0 = A, 1 = B) is held immovable in the shock-propagation pass; freeBody and
+  /// frozenBody are its rows' bodies (solver indices, -1 for none), so that the partitioned pass schedules the
+  /// ranges without reading the rows, which the other thread writes.
   struct ShockRange {
     uint32_t begin, count;
     int frozen;
+    int32_t freeBody, frozenBody;
+  };
+  /// Optional output of the shock pass: before a range that begins below `end` is solved, its rows' impulses are
+  /// copied to lambda[row], on the thread that solves it (the sweeps' impulses, which the next step's warm start
+  /// keeps; solve_stage.cpp rigidShock).
+  struct ShockRecord {
+    Real* lambda;  ///< null: nothing recorded (the default, {})
+    uint32_t end;
   };
   /// Shock propagation (Guendelman, Bridson & Fedkiw 2003): after the sweeps, the given row ranges (ordered
   /// from the ground up) are solved in turn, each with its lower body held immovable, up to `maxSweeps`
@@ -286,7 +296,8 @@ class PgsSolver {
   /// fixed removes the coupling down the stack, and sweeping each support to convergence makes its 4-point
   /// manifold consistent, so the loop gain drops below one.
   static void shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
-                        const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks = nullptr);
+                        const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks = nullptr,
+                        const ShockRecord& record = {});
 
   // ---- issue 18 (sweep scheduling): partitioned sweeps ----
   /// Cuts `partition.units` into regions and a boundary (PgsPartition); call after prepare, every step.
@@ -294,7 +305,9 @@ class PgsSolver {
                         PgsPartition& partition);
   /// `iterations` partitioned sweeps (alternating forward and backward): forward, the regions (in parallel, or
   /// one after the other on one thread), then the boundary; backward, the boundary, then the regions, each
-  /// unit's rows backward. Two barriers per pair of sweeps. Results do not depend on the number of threads.
+  /// unit's rows backward; the boundary colour by colour (PgsPartition::boundaryColours), both threads sweeping
+  /// half of each colour. Two barriers per pair of sweeps and colour (two without colours). Results do not depend
+  /// on the number of threads.
   /// With `blocks`, manifold contacts are swept from the compact records (as in the serial iterate above).
   static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
                       PgsBlocks* blocks, PgsPartition& partition);
@@ -303,7 +316,7 @@ class PgsSolver {
   /// body is their frozen one (point-to-point, no barrier).
   static void shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                         const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks,
-                        PgsPartition& partition);
+                        PgsPartition& partition, const ShockRecord& record = {});
 
  private:
   /// The cutting plane and the bodies' regions (pgs_partition.cpp).
