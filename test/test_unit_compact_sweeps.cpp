@@ -257,13 +257,14 @@ TEST_CASE("partitioned sweeps on their own body layout give the serial sweeps' b
   CHECK(R == 2);
 }
 
-// The boundary by colour (pgs_partition.cpp colourBoundary, pgs.cpp PgsSolver::iterate): a zigzag column of 24
+// The boundary in two shares (pgs_partition.cpp splitBoundary, pgs.cpp PgsSolver::iterate): a zigzag column of 24
 // boxes, L0 R0 L1 R1 ... (L_j body j at x = -0.5, R_j body 12 + j at x = +0.5, each resting on the one before it,
 // the manifold centred on x = 0), so every manifold of the column joins the two regions, like the column of
 // contacts on pyramid20's cut. Each box also carries two free rows (units of one body), so that the scene has the
-// 64 units the partitioned sweeps need for two threads. First fit in the serial order gives the column's manifolds
-// colours 0, 1, 0, 1, ...: 12 and 11 units.
-TEST_CASE("partitioned sweeps: the boundary by colour, both threads sweeping each colour, the bits of one thread") {
+// 64 units the partitioned sweeps need for two threads. The column's 23 manifolds split into the first 11 (thread
+// 0), the last 11 (thread 1) and the 12th (the junction: it shares a box with the first half; thread 0, after a
+// barrier).
+TEST_CASE("partitioned sweeps: the boundary in two shares and a junction, the bits of one thread") {
   constexpr int kPerSide = 12, nb = 2 * kPerSide;
   std::vector<SolverBodyState> bodies(nb);
   std::vector<Vec3> centre(nb);
@@ -313,7 +314,7 @@ TEST_CASE("partitioned sweeps: the boundary by colour, both threads sweeping eac
   setNumThreads(2);
   const bool twoThreads = getNumThreads() == 2;
   WARN_MESSAGE(twoThreads, "built without OpenMP: the 2-thread run used one thread");
-  for (const int iterations : {10, 9}) {  // 9: the last sweep is forward and ends with the boundary's last colour
+  for (const int iterations : {10, 9}) {  // 9: the last sweep is forward and ends with the junction
     CAPTURE(iterations);
     std::vector<ConstraintRow> rowsRun[2];
     std::vector<SolverBodyState> bodiesRun[2];
@@ -326,29 +327,34 @@ TEST_CASE("partitioned sweeps: the boundary by colour, both threads sweeping eac
       PgsBlocks blocks;
       PgsSolver::prepare(rs, bs, &blocks);
       PgsSolver::partition(rs, bs, p);
-      // The cut runs between the sides, so the whole column is the boundary, in two colours.
+      // The cut runs between the sides, so the whole column is the boundary: two shares and the junction.
       REQUIRE(p.axis == 0);
       for (int i = 0; i < nb; ++i) REQUIRE(p.bodyRegion[size_t(i)] == (i < kPerSide ? 0 : 1));
       REQUIRE(p.split[R + 1] - p.split[R] == uint32_t(nb - 1));
-      REQUIRE(p.boundaryColours == 2);
+      REQUIRE(p.boundaryPhases == 2);
       CHECK(p.boundarySplit[0] == p.split[R]);
-      CHECK(p.boundarySplit[1] - p.boundarySplit[0] == 12);
-      CHECK(p.boundarySplit[2] == p.split[R + 1]);
-      for (int c = 0; c < p.boundaryColours; ++c) {
-        std::vector<int> seen(nb, 0);
-        for (uint32_t u = p.boundarySplit[c]; u < p.boundarySplit[c + 1]; ++u) {
-          const ConstraintRow& r = rs[p.order[u].begin];
-          CHECK(++seen[size_t(r.bodyA)] == 1);  // no two units of a colour share a body
-          CHECK(++seen[size_t(r.bodyB)] == 1);
-          if (u > p.boundarySplit[c]) CHECK(p.order[u - 1].begin < p.order[u].begin);  // serial order kept
+      CHECK(p.boundaryMid[0] - p.boundarySplit[0] == 11);
+      CHECK(p.boundarySplit[1] - p.boundaryMid[0] == 11);
+      CHECK(p.boundaryMid[1] == p.split[R + 1]);  // the junction is thread 0's
+      CHECK(p.boundarySplit[2] - p.boundarySplit[1] == 1);
+      // The two shares of phase 0 touch disjoint bodies; each keeps the serial order; the junction is the 12th.
+      std::vector<int> share(nb, -1);
+      for (uint32_t u = p.boundarySplit[0]; u < p.boundarySplit[1]; ++u) {
+        const int s = u < p.boundaryMid[0] ? 0 : 1;
+        const ConstraintRow& r = rs[p.order[u].begin];
+        for (const int32_t x : {r.bodyA, r.bodyB}) {
+          CHECK((share[size_t(x)] < 0 || share[size_t(x)] == s));
+          share[size_t(x)] = s;
         }
+        if (u != p.boundarySplit[0] && u != p.boundaryMid[0]) CHECK(p.order[u - 1].begin < p.order[u].begin);
       }
-      CHECK(std::all_of(p.colourMask.begin(), p.colourMask.end(), [](uint8_t m) { return m == 0; }));
+      CHECK(p.order[p.boundarySplit[1]].begin == proto.units[11].begin);
+      CHECK(std::all_of(p.bodyMark.begin(), p.bodyMark.end(), [](uint8_t m) { return m == 0; }));
       delta[threads - 1] = PgsSolver::iterate(rs, bs, iterations, &blocks, p);
       rowsRun[threads - 1] = rs;
       bodiesRun[threads - 1] = bs;
     }
-    // Bit for bit: the units of a colour share no body, so the threads' halves of a colour commute.
+    // Bit for bit: the two shares of a phase touch disjoint bodies, so they commute.
     CHECK(delta[0] == delta[1]);
     for (size_t i = 0; i < rows.size(); ++i) {
       CAPTURE(i);

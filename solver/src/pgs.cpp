@@ -1879,17 +1879,18 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   runTeam(threads, [&](int t, int nt) {
     if (nt < threads) p.teamBusy = true;  // only the calling thread runs then (nt == 1)
     auto owns = [&](int g) { return g % nt == t; };
-    // The boundary's units of this thread: with colours and two threads, per colour (PgsPartition::boundaryColours)
-    // the first half of its units for thread 0 and the rest for thread 1; else all of them for thread 0. The
-    // boundary is sorted by colour, so one thread sweeping it whole keeps the same order.
-    const int phases = p.boundaryColours > 0 && nt > 1 ? p.boundaryColours : 1;
+    // The boundary's units of this thread: with phases and two threads, its share of each phase
+    // (PgsPartition::boundaryPhases); else all of them for thread 0. The phases are in the serial order, so one
+    // thread sweeping the boundary whole keeps the same order.
+    const bool shared = p.boundaryPhases > 0 && nt > 1;
+    const int phases = shared ? p.boundaryPhases : 1;
     auto boundaryShare = [&](int c, uint32_t& first, uint32_t& last) {
-      first = last = split[R];
-      if (phases == 1) {
-        if (t == 0) last = split[R + 1];
+      if (!shared) {
+        first = split[R];
+        last = t == 0 ? split[R + 1] : split[R];
         return;
       }
-      const uint32_t cb = p.boundarySplit[c], ce = p.boundarySplit[c + 1], mid = cb + (ce - cb + 1) / 2;
+      const uint32_t cb = p.boundarySplit[c], ce = p.boundarySplit[c + 1], mid = p.boundaryMid[c];
       first = t == 0 ? cb : mid;
       last = t == 0 ? mid : ce;
     };
@@ -1917,8 +1918,8 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
       boundaryShare(c, first, last);
       if (first < last) local = std::max(local, sweepUnits(rows, lb, order, manifold, first, last, forward, blocks));
     };
-    // A forward sweep: the regions, then the boundary colour by colour; a backward sweep the reverse. The last
-    // colour of a forward sweep and the first of the next backward sweep are the same units on the same threads,
+    // A forward sweep: the regions, then the boundary phase by phase; a backward sweep the reverse. The last
+    // phase of a forward sweep and the first of the next backward sweep are the same units on the same threads,
     // so no barrier between them.
     for (int it = 0; it < iterations; ++it) {
       const bool forward = it % 2 == 0;

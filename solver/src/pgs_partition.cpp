@@ -19,7 +19,6 @@
 //    body index), never on the thread count; within each group the units keep the serial sweep's order.
 //  - Cost: three sorts of the movable bodies per step (pyramid20: 210 bodies), storage reused across steps.
 #include <algorithm>
-#include <bit>
 
 #include "scree/solver/pgs.h"
 
@@ -82,71 +81,75 @@ void PgsSolver::partition(const std::vector<ConstraintRow>& rows, const std::vec
   for (int g = 0; g <= R; ++g) next[g] = p.split[g];
   p.order.resize(nu);
   for (size_t u = 0; u < nu; ++u) p.order[next[p.unitGroup[u]]++] = p.units[u];
-  colourBoundary(rows, bodies, p);
+  splitBoundary(rows, bodies, p);
 }
 
 // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "The boundary swept by both threads"): until
-// then thread 0 swept the whole boundary while thread 1 waited. The boundary's units couple a body of each region,
-// so half of its bodies sit in the other thread's cache: per row it cost pyramid20 about three times a region's
-// row (perf), and it was about a quarter of thread 1's waits. Units of one colour share no movable body (a boundary
-// unit has two movable bodies and no static one), so their order within the colour does not change the result:
-// each thread sweeps half of every colour, with a barrier between colours. The serial order becomes colour by
-// colour (first fit in the serial order), on one thread as on two, so the bits stay independent of the thread
-// count. Colouring costs two barriers per pair of sweeps and colour; it is used only when each colour has units
-// enough to pay for them.
-void PgsSolver::colourBoundary(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
-                               PgsPartition& p) {
+// stop 47 thread 0 swept the whole boundary while thread 1 waited. The boundary's units couple a body of each
+// region, so half of its bodies sit in the other thread's cache: per row it cost pyramid20 about three times a
+// region's row (perf), and it was about a quarter of thread 1's waits. Now the boundary is cut in two halves in
+// the serial order: the first half H0, then the units of the second half that share no movable body with H0
+// (H1), then the rest (J, the junction). H0 and H1 touch disjoint bodies, so they commute: thread 0 sweeps H0
+// while thread 1 sweeps H1, then thread 0 sweeps J after a barrier. On one thread the order is H0, H1, J, the
+// same. A colouring (units of one colour share no body) was tried first: it gave the same balance, but on
+// pyramid20, whose boundary is one column of contacts, it swept the column every other contact, and the clamped
+// block solves rose by 40 % (callgrind: the one-thread partitioned step +1.1 % instructions). The halves keep the
+// column's order but at one contact. The split costs two barriers per pair of sweeps; it is made only when both
+// halves have units enough to pay for them and J is small.
+void PgsSolver::splitBoundary(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                              PgsPartition& p) {
   constexpr int R = PgsPartition::kRegions;
-  constexpr int kMinUnitsPerColour = 4;
-  constexpr int C = PgsPartition::kMaxBoundaryColours;
-  const uint32_t first = p.split[R], last = p.split[R + 1];
-  p.boundaryColours = 0;
-  if (last - first < uint32_t(2 * kMinUnitsPerColour)) return;
-  if (p.colourMask.size() < std::max(bodies.size(), p.bodyRegion.size()))
-    p.colourMask.resize(std::max(bodies.size(), p.bodyRegion.size()), 0);
-  p.unitColour.resize(last - first);
-  uint32_t count[C] = {};
-  bool fits = true;
-  for (uint32_t u = first; u < last; ++u) {
-    // Only units of two bodies the regions hold: a static or kinematic body has a private copy per view, which
-    // two threads must not both write, and a body the kept cut did not see is local to the boundary's view.
-    const ConstraintRow& r = p.order[u].count > 0 ? rows[p.order[u].begin] : rows.front();
-    const int32_t b[2] = {r.bodyA, r.bodyB};
-    bool held = p.order[u].count > 0;
-    for (const int32_t x : b) held = held && x >= 0 && size_t(x) < p.bodyRegion.size() && p.bodyRegion[size_t(x)] >= 0;
-    if (!held) {
-      fits = false;
-      break;
-    }
-    const uint8_t used = uint8_t(p.colourMask[size_t(b[0])] | p.colourMask[size_t(b[1])]);
-    const int c = std::countr_one(unsigned(used));
-    if (c >= C) {
-      fits = false;
-      break;
-    }
-    for (const int32_t x : b) p.colourMask[size_t(x)] |= uint8_t(1u << c);
-    p.unitColour[u - first] = uint8_t(c);
-    ++count[c];
-  }
-  for (uint32_t u = first; u < last; ++u) {  // the mask back to zero
-    if (p.order[u].count == 0) continue;
+  constexpr uint32_t kMinUnitsPerHalf = 4;
+  const uint32_t first = p.split[R], last = p.split[R + 1], n = last - first;
+  p.boundaryPhases = 0;
+  if (n < 2 * kMinUnitsPerHalf) return;
+  const size_t nb = std::max(bodies.size(), p.bodyRegion.size());
+  if (p.bodyMark.size() < nb) p.bodyMark.resize(nb, 0);
+  // Only units of two bodies the regions hold: a static or kinematic body has a private copy per view, which two
+  // threads must not both write, and a body the kept cut did not see is local to the boundary's view.
+  auto bodiesOf = [&](uint32_t u, int32_t b[2]) {
+    if (p.order[u].count == 0) return false;
     const ConstraintRow& r = rows[p.order[u].begin];
-    for (const int32_t x : {r.bodyA, r.bodyB})
-      if (x >= 0 && size_t(x) < p.colourMask.size()) p.colourMask[size_t(x)] = 0;
+    b[0] = r.bodyA;
+    b[1] = r.bodyB;
+    for (int k = 0; k < 2; ++k)
+      if (b[k] < 0 || size_t(b[k]) >= p.bodyRegion.size() || p.bodyRegion[size_t(b[k])] < 0) return false;
+    return true;
+  };
+  const uint32_t half = first + n / 2;
+  bool held = true;
+  int32_t b[2];
+  for (uint32_t u = first; u < half && held; ++u) {
+    held = bodiesOf(u, b);
+    if (held) p.bodyMark[size_t(b[0])] = p.bodyMark[size_t(b[1])] = 1;
   }
-  if (!fits) return;
-  int colours = 0;
-  while (colours < C && count[colours] > 0) ++colours;
-  for (int c = 0; c < colours; ++c)
-    if (count[c] < uint32_t(kMinUnitsPerColour)) return;
-  // Stable sort by colour.
+  // The second half in order: H1 first, then the junction.
+  p.unitScratch.clear();
+  uint32_t junction = 0;
+  for (int pass = 0; pass < 2 && held; ++pass)
+    for (uint32_t u = half; u < last && held; ++u) {
+      held = bodiesOf(u, b);
+      const bool joins = held && (p.bodyMark[size_t(b[0])] || p.bodyMark[size_t(b[1])]);
+      if (held && joins == (pass == 1)) p.unitScratch.push_back(p.order[u]);
+      junction += held && pass == 0 && joins;
+    }
+  for (uint32_t u = first; u < half; ++u)  // the marks back to zero
+    if (p.order[u].count > 0)
+      for (const int32_t x : {rows[p.order[u].begin].bodyA, rows[p.order[u].begin].bodyB})
+        if (x >= 0 && size_t(x) < p.bodyMark.size()) p.bodyMark[size_t(x)] = 0;
+  // Not worth two barriers: a second half of too few units, or a junction of more than a quarter.
+  const uint32_t h1 = last - half - junction;
+  if (!held || h1 < kMinUnitsPerHalf || junction * 4 > n) return;
+  std::copy(p.unitScratch.begin(), p.unitScratch.end(), p.order.begin() + half);
   p.boundarySplit[0] = first;
-  for (int c = 0; c < colours; ++c) p.boundarySplit[c + 1] = p.boundarySplit[c] + count[c];
-  uint32_t next[C];
-  for (int c = 0; c < colours; ++c) next[c] = p.boundarySplit[c];
-  p.unitScratch.assign(p.order.begin() + first, p.order.begin() + last);
-  for (uint32_t u = first; u < last; ++u) p.order[next[p.unitColour[u - first]]++] = p.unitScratch[u - first];
-  p.boundaryColours = colours;
+  p.boundaryMid[0] = half;
+  p.boundarySplit[1] = half + h1;
+  p.boundaryPhases = 1;
+  if (junction > 0) {
+    p.boundaryMid[1] = last;  // the junction: thread 0's
+    p.boundarySplit[2] = last;
+    p.boundaryPhases = 2;
+  }
 }
 
 void PgsSolver::cutRegions(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,

@@ -183,22 +183,23 @@ struct PgsPartition {
   std::vector<Unit> order;
   uint32_t split[kRegions + 2] = {};
   std::vector<int8_t> bodyRegion;  ///< per solver body: its region, -1 for static and kinematic bodies
-  /// The boundary's units by colour: no two units of one colour share a movable body, so both threads sweep a
-  /// colour at once (PgsSolver::iterate), a barrier between colours. The boundary's units in `order` are sorted by
-  /// colour, in the serial sweep's order within each; colour c is [boundarySplit[c], boundarySplit[c + 1]).
-  /// boundaryColours 0: the boundary is one group that thread 0 sweeps (more than kMaxBoundaryColours colours,
-  /// or too few units per colour to pay for the barriers). Depends on the scene only, never on the thread count.
-  static constexpr int kMaxBoundaryColours = 4;
-  int boundaryColours = 0;
-  uint32_t boundarySplit[kMaxBoundaryColours + 1] = {};
+  /// The boundary's units in phases that both threads sweep at once (PgsSolver::iterate), with a barrier between
+  /// phases: phase c is [boundarySplit[c], boundarySplit[c + 1]), thread 0 taking [boundarySplit[c],
+  /// boundaryMid[c]) and thread 1 the rest; no unit of one share shares a movable body with the other's. The
+  /// boundary's units in `order` are in that order, which is also the serial sweep's (PgsSolver::splitBoundary).
+  /// boundaryPhases 0: the boundary is one group that thread 0 sweeps. Depends on the scene only, never on the
+  /// thread count.
+  static constexpr int kMaxBoundaryPhases = 2;
+  int boundaryPhases = 0;
+  uint32_t boundarySplit[kMaxBoundaryPhases + 1] = {};
+  uint32_t boundaryMid[kMaxBoundaryPhases] = {};
   int axis = 0;                    ///< the cutting plane's normal (0 x, 1 y, 2 z)
   // Scratch (reused).
   std::vector<uint32_t> sortedBodies;
   std::vector<Real> bodyWeight;
   std::vector<int8_t> unitGroup;
   std::vector<uint64_t> signature;  ///< the units' body pairs and row counts when the cut was last made
-  std::vector<uint8_t> colourMask;  ///< per solver body: the boundary colours of its units (zero between calls)
-  std::vector<uint8_t> unitColour;  ///< per boundary unit: its colour
+  std::vector<uint8_t> bodyMark;  ///< per solver body (zero between calls; splitBoundary)
   std::vector<Unit> unitScratch;
   std::vector<int32_t> unitManifold;  ///< per unit of `order`: its compact record (PgsBlocks::manifolds) or -1
   /// The sweeps' own copy of the bodies, region by region (PgsSolver::iterate with a partition): each region's
@@ -305,9 +306,9 @@ class PgsSolver {
                         PgsPartition& partition);
   /// `iterations` partitioned sweeps (alternating forward and backward): forward, the regions (in parallel, or
   /// one after the other on one thread), then the boundary; backward, the boundary, then the regions, each
-  /// unit's rows backward; the boundary colour by colour (PgsPartition::boundaryColours), both threads sweeping
-  /// half of each colour. Two barriers per pair of sweeps and colour (two without colours). Results do not depend
-  /// on the number of threads.
+  /// unit's rows backward; the boundary phase by phase (PgsPartition::boundaryPhases), both threads sweeping
+  /// their share of each phase. Two barriers per pair of sweeps and phase (two without phases). Results do not
+  /// depend on the number of threads.
   /// With `blocks`, manifold contacts are swept from the compact records (as in the serial iterate above).
   static Real iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies, int iterations,
                       PgsBlocks* blocks, PgsPartition& partition);
@@ -322,9 +323,9 @@ class PgsSolver {
   /// The cutting plane and the bodies' regions (pgs_partition.cpp).
   static void cutRegions(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
                          PgsPartition& partition);
-  /// The boundary's colours (PgsPartition::boundaryColours; pgs_partition.cpp).
-  static void colourBoundary(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
-                             PgsPartition& partition);
+  /// The boundary's phases (PgsPartition::boundaryPhases; pgs_partition.cpp).
+  static void splitBoundary(const std::vector<ConstraintRow>& rows, const std::vector<SolverBodyState>& bodies,
+                            PgsPartition& partition);
   /// One range of the shock pass swept to convergence (shockPass's per-range body).
   static void shockRange(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                          const ShockRange& sr, int maxSweeps, const PgsBlocks* blocks);
