@@ -8,7 +8,8 @@
 //    colours x 10 sweeps, plus the single-thread groups), and on a 2-core machine each barrier costs about as much
 //    as the work between two of them. Two regions need a barrier only where the sweep passes from the regions
 //    to the boundary and back: since the sweeps alternate direction, a forward sweep ends and the next backward
-//    sweep begins with the boundary, so a pair of sweeps needs two barriers, ten sweeps ten.
+//    sweep begins with the boundary, so a pair of sweeps needs two barriers, ten sweeps ten. The boundary itself
+//    is shared out in two phases when it is large enough (splitBoundary below): two more barriers per pair.
 //  - The cut: a plane normal to one coordinate axis through the weighted median of the movable bodies' positions,
 //    each body weighted by the rows of its units (a unit's rows shared equally among its movable bodies), so the
 //    two regions carry about equal work. All three axes are tried and the one whose boundary holds the fewest
@@ -16,7 +17,8 @@
 //    change them, so units of both regions may read them (pgs.cpp gives region 1's units private copies so that
 //    no two threads store to one body).
 //  - Determinism: the cut depends only on positions, rows and body indices (ties in a coordinate broken by the
-//    body index), never on the thread count; within each group the units keep the serial sweep's order.
+//    body index), never on the thread count; within each group the units keep the serial sweep's order (the
+//    boundary's: that of its phases, itself a serial order).
 //  - Cost: three sorts of the movable bodies per step (pyramid20: 210 bodies), storage reused across steps.
 #include <algorithm>
 
