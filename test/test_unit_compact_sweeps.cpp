@@ -74,6 +74,19 @@ int addManifold(std::vector<ConstraintRow>& rows, int a, int b, const Vec3& ca, 
   return base;
 }
 
+/// A bounded free row on one body (a unit of its own in the partitioned sweeps' tests): |lambda| <= 1.
+ConstraintRow boundedFreeRow(int body, const Vec3& jLin, Real rhs) {
+  ConstraintRow r;
+  r.bodyA = body;
+  r.jLinA = jLin;
+  r.jAngA = Vec3(0, 0, 1);
+  r.rhs = rhs;
+  r.e = 1e-4;
+  r.lo = -1;
+  r.hi = 1;
+  return r;
+}
+
 }  // namespace
 
 // Two unit boxes (mass 2) stacked on the static ground, the upper one tipping (w_x = 3 rad/s: its block update
@@ -186,16 +199,8 @@ TEST_CASE("partitioned sweeps on their own body layout give the serial sweeps' b
   PgsPartition p;
   auto unit = [&](int begin) { p.units.push_back({uint32_t(begin), uint32_t(rows.size()) - uint32_t(begin)}); };
   auto freeRow = [&](int body) {
-    ConstraintRow r;
-    r.bodyA = body;
-    r.jLinA = Vec3(0.3, 1, 0).normalized();
-    r.jAngA = Vec3(0, 0, 1);
-    r.rhs = 0.05;
-    r.e = 1e-4;
-    r.lo = -1;
-    r.hi = 1;
     const int begin = int(rows.size());
-    rows.push_back(r);
+    rows.push_back(boundedFreeRow(body, Vec3(0.3, 1, 0).normalized(), 0.05));
     unit(begin);
   };
   // Region 0's units, region 1's, then the boundary's: the partition's order is the row order.
@@ -296,16 +301,8 @@ TEST_CASE("partitioned sweeps: the boundary in two shares and a junction, the bi
   }
   for (int i = 0; i < nb; ++i)
     for (int k = 0; k < 2; ++k) {
-      ConstraintRow r;
-      r.bodyA = i;
-      r.jLinA = k == 0 ? Vec3(0.3, 1, 0).normalized() : Vec3(0, 0.6, 0.8);
-      r.jAngA = Vec3(0, 0, 1);
-      r.rhs = 0.05 * (k + 1);
-      r.e = 1e-4;
-      r.lo = -1;
-      r.hi = 1;
       const int begin = int(rows.size());
-      rows.push_back(r);
+      rows.push_back(boundedFreeRow(i, k == 0 ? Vec3(0.3, 1, 0).normalized() : Vec3(0, 0.6, 0.8), 0.05 * (k + 1)));
       unit(begin);
     }
   REQUIRE(proto.units.size() >= 64);
