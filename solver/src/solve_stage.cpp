@@ -106,10 +106,9 @@ void rigidShock(SimulationState& s, bool onlyIterative) {
   // multi-support contacts start from the sweeps' impulses alone. Joints are left as they were (their warm
   // start is Constraint::storeResult's). Reported contact forces are the solved impulses, shock pass included.
   s.sweepLambda.assign(s.rows.size(), std::numeric_limits<Real>::quiet_NaN());
-  auto freeBody = [](const PgsSolver::ShockRange& r) { return r.freeBody; };
   s.shockSupports.assign(s.sb.size(), 0);
   for (const PgsSolver::ShockRange& r : sh)
-    if (freeBody(r) >= 0) ++s.shockSupports[freeBody(r)];
+    if (r.freeBody >= 0) ++s.shockSupports[r.freeBody];
   uint32_t contactEnd = uint32_t(s.rows.size());  // contact rows come first, then constraint rows
   for (const auto& cr : s.ranges) contactEnd = std::min(contactEnd, cr.begin);
   // The sweeps' impulses of the contact supports are recorded by the pass, on the thread that solves each range
@@ -121,7 +120,7 @@ void rigidShock(SimulationState& s, bool onlyIterative) {
   else
     PgsSolver::shockPass(s.rows, s.sb, sh, s.solver.getNumShockIterations(), &s.pgsBlocks, record);
   for (const PgsSolver::ShockRange& r : sh) {
-    if (r.begin >= contactEnd || (freeBody(r) >= 0 && s.shockSupports[freeBody(r)] > 1)) continue;
+    if (r.begin >= contactEnd || (r.freeBody >= 0 && s.shockSupports[r.freeBody] > 1)) continue;
     Real added = 0;
     int n = 0;
     for (uint32_t i = r.begin; i < r.begin + r.count; ++i)
