@@ -456,6 +456,85 @@ TEST_CASE("partitioned work that finds the team busy: the stats report the one t
   CHECK(std::memcmp(one.data(), mixed.data(), one.size() * sizeof(Real)) == 0);
 }
 
+TEST_CASE("partitioned work too small to split: the stats report the one thread the sweeps ran on") {
+  // The sweeps split only from 64 units and the shock pass from 16 ranges (pgs.cpp partitionThreads); below that
+  // they run on the calling thread whatever the count asked for. tower10 (10 contacts, 10 shock ranges) asks
+  // for two threads and runs on one: SolverStats::numSweepThreads must say one. pyramid20 (about 400 units) runs
+  // on two and must say two. Adaptive count off, so that two threads are asked for on every step.
+  setNumThreads(2);
+  const bool twoThreads = getNumThreads() == 2;
+  setNumThreads(1);
+  if (!twoThreads) {
+    WARN_MESSAGE(false, "built without OpenMP: no second thread to ask for");
+    return;
+  }
+  setNumThreads(2);
+  scenes::TowerScene tower = scenes::buildTower10();
+  scenes::PyramidScene pyramid = scenes::buildPyramid20();
+  for (Simulation* sim : {tower.sim.get(), pyramid.sim.get()}) {
+    sim->getSolver().setUsePartitionedSweeps(true);
+    sim->getSolver().setUseAdaptiveSweepThreads(false);
+  }
+  std::vector<int> towerThreads, pyramidThreads;
+  for (int i = 0; i < 5; ++i) {
+    tower.step();
+    pyramid.step();
+    towerThreads.push_back(tower.sim->getSolver().getStats().numSweepThreads);
+    pyramidThreads.push_back(pyramid.sim->getSolver().getStats().numSweepThreads);
+  }
+  setNumThreads(1);
+  for (size_t i = 0; i < towerThreads.size(); ++i) {
+    CAPTURE(i);
+    CHECK(towerThreads[i] == 1);
+    CHECK(pyramidThreads[i] == 2);
+  }
+}
+
+TEST_CASE("adaptive sweep threads: a probe whose two-thread steps find the team busy keeps one thread") {
+  // The +infinity samples of SweepThreadChoice::end, end to end. pyramid20 partitioned, the adaptive count on (the
+  // default), two threads. The probe's first kProbeSteps steps ask for two threads; they are taken inside a team
+  // job, so the team is busy, they run on one thread and must be timed as +infinity. The next kProbeSteps ask
+  // for one and run outside it with 10x the sweeps (100 against 10), so each takes about three times as long
+  // as a busy step. The choice must then be one thread: had the busy steps been timed as two threads' steps,
+  // two threads would have won by that factor, and the hold after the probe would report two. The state must
+  // also be the one-thread run's, bit for bit, under the same schedule of sweep counts.
+  setNumThreads(2);
+  const bool twoThreads = getNumThreads() == 2;
+  setNumThreads(1);
+  if (!twoThreads) {
+    WARN_MESSAGE(false, "built without OpenMP: no second thread to choose");
+    return;
+  }
+  constexpr int P = SweepThreadChoice::kProbeSteps, steps = 2 * P + 6;
+  auto run = [&](int threads, std::vector<int>* counts) {
+    setNumThreads(threads);
+    scenes::PyramidScene s = scenes::buildPyramid20();
+    Solver& solver = s.sim->getSolver();
+    REQUIRE(solver.getUseAdaptiveSweepThreads());
+    solver.setUsePartitionedSweeps(true);
+    const int iterations = solver.getNumIterations();
+    for (int i = 0; i < steps; ++i) {
+      solver.setNumIterations(i >= P && i < 2 * P ? 10 * iterations : iterations);
+      if (i < P) runTeam(2, [&](int t, int) {
+          if (t == 0) s.step();
+        });
+      else s.step();
+      if (counts) counts->push_back(solver.getStats().numSweepThreads);
+    }
+    setNumThreads(1);
+    return pyramidState(s);
+  };
+  const std::vector<Real> one = run(1, nullptr);
+  std::vector<int> counts;
+  const std::vector<Real> adaptive = run(2, &counts);
+  for (int i = 0; i < steps; ++i) {
+    CAPTURE(i);
+    CHECK(counts[size_t(i)] == 1);  // busy, then the probe of one, then the hold on one
+  }
+  REQUIRE(one.size() == adaptive.size());
+  CHECK(std::memcmp(one.data(), adaptive.data(), one.size() * sizeof(Real)) == 0);
+}
+
 // ---- issue 18 (sweep scheduling): the persistent team the partitioned stages run on (scree/core/parallel.h) ----
 TEST_CASE("persistent team: every index once on its own thread, barrier order, nested and concurrent calls") {
   // Two indices, two distinct threads, t = 0 on the caller; repeated so that the sleeping worker is woken too.

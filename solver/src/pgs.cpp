@@ -1876,8 +1876,10 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
   const int threads = partitionThreads(nu >= 64, p);
   Real lastSweep[R] = {};
   TeamBarrier barrier(threads);
+  int ran = threads;
   runTeam(threads, [&](int t, int nt) {
     if (nt < threads) p.teamBusy = true;  // only the calling thread runs then (nt == 1)
+    if (t == 0) ran = nt;
     auto owns = [&](int g) { return g % nt == t; };
     // The boundary's units of this thread: with phases and two threads, its share of each phase
     // (PgsPartition::boundaryPhases); else all of them for thread 0. The phases are in the serial order, so one
@@ -1957,6 +1959,7 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
         for (size_t k = slots[g]; k < slots[g + 1]; ++k)
           if (p.globalOf[k] >= 0 && movableBody(p.globalOf[k])) bodies[size_t(p.globalOf[k])] = lb[k];
   });
+  p.threadsRan = std::max(p.threadsRan, ran);
   Real maxDelta = 0;
   for (int t = 0; t < R; ++t) maxDelta = std::max(maxDelta, lastSweep[t]);
   return maxDelta;
@@ -1976,6 +1979,7 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
   const int threads = partitionThreads(ranges.size() >= 16, p);
   if (threads < 2) {
     shockPass(rows, bodies, ranges, maxSweeps, blocks, record);
+    p.threadsRan = std::max(p.threadsRan, 1);
     return;
   }
   const size_t nb = bodies.size();
@@ -2001,7 +2005,9 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
     std::atomic<uint32_t> v{0};
   };
   Counter done[R];
+  int ran = threads;
   runTeam(threads, [&](int t, int nt) {
+    if (t == 0) ran = nt;
     if (nt < R) {
       // Fewer threads than lists (the team was busy): the serial pass (the same bits).
       p.teamBusy = true;  // only the calling thread runs then (nt == 1)
@@ -2018,6 +2024,7 @@ void PgsSolver::shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBo
       }
     }
   });
+  p.threadsRan = std::max(p.threadsRan, ran);
 }
 
 }  // namespace scree::detail

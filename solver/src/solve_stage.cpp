@@ -308,8 +308,9 @@ void iterativePath(SimulationState& s, bool interleaved) {
   st.lastResidual = residual;
   st.numIterations = size_t(iterations);
   if (!s.rows.empty()) rigidShock(s, false);
-  // The count the sweeps and the shock pass ran on: the one asked for, or one if a job found the team busy.
-  if (s.partitionReady) st.numSweepThreads = s.partition.teamBusy ? 1 : s.partition.maxThreads;
+  // The count the sweeps and the shock pass ran on: the one asked for, or one if the work was too small to split
+  // or a job found the team busy.
+  if (s.partitionReady) st.numSweepThreads = std::max(1, s.partition.threadsRan);
 }
 
 }  // namespace
@@ -317,6 +318,7 @@ void iterativePath(SimulationState& s, bool interleaved) {
 void beginPartitionedWork(SimulationState& s) {
   s.partitionSpanStarted = false;
   s.rowBuildTeamBusy = s.partition.teamBusy = false;
+  s.partition.threadsRan = 0;
   if (!s.solver.getUsePartitionedSweeps()) return;
   const int available = std::min(PgsPartition::kRegions, scree::getNumThreads());
   const bool adaptive = s.solver.getUseAdaptiveSweepThreads();

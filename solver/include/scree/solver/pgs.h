@@ -220,6 +220,10 @@ struct PgsPartition {
   /// Simulation held the team (scree/core/parallel.h runTeamJob; the bits are the same). Never cleared here: the
   /// caller clears it before the step's partitioned work.
   bool teamBusy = false;
+  /// Output: the most threads a sweep or shock job of the step ran on: 1 when the work was too small to split
+  /// (fewer than 64 units, or 16 shock ranges) or the team was busy, 0 when none ran. Never cleared here: the
+  /// caller clears it before the step's partitioned work (SolverStats::numSweepThreads reports it).
+  int threadsRan = 0;
 };
 
 class PgsSolver {

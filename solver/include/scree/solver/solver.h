@@ -38,8 +38,10 @@ struct SolverStats {
   Real projectionDrift = 0;     ///< largest |drift| of a projected row before the projection, m or rad
   Real projectionResidual = 0;  ///< largest drift beyond the tolerance after it (0 when no iteration ran)
   /// Threads the partitioned sweeps and shock pass ran on this step (Solver::setUsePartitionedSweeps,
-  /// setUseAdaptiveSweepThreads); 1 on every other path, and 1 when they found the thread team busy (another
-  /// Simulation stepping on another thread at the same moment; the results are the same bits).
+  /// setUseAdaptiveSweepThreads); 1 on every other path, 1 when the work was too small to split (fewer than 64
+  /// units in the sweeps and 16 supports in the shock pass: tower10, for example), and 1 when they found the
+  /// thread team busy (another Simulation stepping on another thread at the same moment; the results are the same
+  /// bits).
   int numSweepThreads = 1;
   /// Threads the contact rows were built on this step: with partitioned sweeps and at least 128 contacts the
   /// sweeps' count, else 1; 1 too when the build found the team busy. The rows are the same bits on any count.
