@@ -492,6 +492,54 @@ TEST_CASE("normal rows prepared on first use give the prepared rows' sweeps, fal
   }
 }
 
+TEST_CASE("a plain prepare after partitioned sweeps: the shock pass finds no record of the step before") {
+  // The HYBRID path (solve_stage.cpp hybridPath) prepares its rows with the plain PgsSolver::prepare, sweeps a
+  // subset of them without compact records and runs the shock pass, which looks a support's record up by its
+  // first row (PgsBlocks::rowManifold, filled by the partitioned sweeps). After a step of partitioned sweeps in
+  // the same PgsBlocks, that lookup must find nothing, so that each support is solved from this step's rows as
+  // with a fresh PgsBlocks; before stop 46 the plain prepare left the lookup of the step before in place, pointing
+  // at records it had just cleared. Step 1: TippingStack, partitioned sweeps. Step 2: its rows again, with step
+  // 1's impulses as the warm start, prepared plainly in the same PgsBlocks, then the shock pass; against the same
+  // on a fresh PgsBlocks, bit for bit.
+  const TippingStack scene(true);
+  const PgsSolver::ShockRange m0{uint32_t(scene.m0), 7, 1, 0, -1}, m1{uint32_t(scene.m1), 7, 1, 1, 0};
+  PgsBlocks blocks;
+  PgsPartition p;
+  p.units = {{0, 1}, {uint32_t(scene.m0), 7}, {uint32_t(scene.m1), 7}, {uint32_t(scene.m1 + 7), 1}};
+  p.bodyPosition = {Vec3(0, 0, 0.5), Vec3(0.1, 0, 1.5), Vec3::Zero()};
+  std::vector<ConstraintRow> rows1 = scene.rows;
+  std::vector<SolverBodyState> bodies1 = scene.bodies;
+  PgsSolver::prepare(rows1, bodies1, &blocks);
+  PgsSolver::partition(rows1, bodies1, p);
+  PgsSolver::iterate(rows1, bodies1, 10, &blocks, p);
+  // Both supports were swept from records, which the lookup finds.
+  REQUIRE(blocks.rowManifold.size() == rows1.size());
+  REQUIRE(blocks.rowManifold[size_t(scene.m0)] >= 0);
+  REQUIRE(blocks.rowManifold[size_t(scene.m1)] >= 0);
+
+  std::vector<ConstraintRow> rows2 = scene.rows;
+  for (size_t i = 0; i < rows2.size(); ++i) rows2[i].lambda = rows1[i].lambda;
+  std::vector<ConstraintRow> rowsF = rows2;
+  std::vector<SolverBodyState> bodies2 = scene.bodies, bodiesF = scene.bodies;
+  PgsBlocks fresh;
+  PgsSolver::prepare(rows2, bodies2, &blocks);
+  PgsSolver::prepare(rowsF, bodiesF, &fresh);
+  PgsSolver::shockPass(rows2, bodies2, {m0, m1}, 16, &blocks);
+  PgsSolver::shockPass(rowsF, bodiesF, {m0, m1}, 16, &fresh);
+  Real scale = 0;
+  for (size_t i = 0; i < rowsF.size(); ++i) {
+    CAPTURE(i);
+    CHECK(rows2[i].lambda == rowsF[i].lambda);
+    scale = std::max(scale, std::abs(rowsF[i].lambda));
+  }
+  CHECK(scale > 0.1);  // the supports carry load
+  for (size_t b = 0; b < bodiesF.size(); ++b) {
+    CAPTURE(b);
+    CHECK(bodies2[b].v == bodiesF[b].v);
+    CHECK(bodies2[b].w == bodiesF[b].w);
+  }
+}
+
 TEST_CASE("prepare on rows grouped by region: the serial prepare's bits, the regions on two threads") {
   // PgsSolver::prepare with PrepareGroups (pgs.cpp; the grouped contact row build lays the rows out so):
   // region 0's rows, region 1's, then the rest (boundary contacts, joints), the regions on two threads at once
