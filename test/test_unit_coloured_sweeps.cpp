@@ -494,7 +494,7 @@ TEST_CASE("adaptive sweep threads: a probe whose two-thread steps find the team 
   // The +infinity samples of SweepThreadChoice::end, end to end. pyramid20 partitioned, the adaptive count on (the
   // default), two threads. The probe's first kProbeSteps steps ask for two threads; they are taken inside a team
   // job, so the team is busy, they run on one thread and must be timed as +infinity. The next kProbeSteps ask
-  // for one and run outside it with 10x the sweeps (100 against 10), so each takes about three times as long
+  // for one and run outside it with 10x the sweeps (100 against 10), so each takes several times as long
   // as a busy step. The choice must then be one thread: had the busy steps been timed as two threads' steps,
   // two threads would have won by that factor, and the hold after the probe would report two. The state must
   // also be the one-thread run's, bit for bit, under the same schedule of sweep counts.
