@@ -24,6 +24,16 @@
 using namespace scree;
 using namespace scree::detail;
 
+namespace {
+/// Whether setNumThreads(2) gives two threads (not when built without OpenMP); leaves the count at one.
+bool twoThreadsAvailable() {
+  setNumThreads(2);
+  const bool two = getNumThreads() == 2;
+  setNumThreads(1);
+  return two;
+}
+}  // namespace
+
 TEST_SUITE("coloured sweeps") {
 
 namespace {
@@ -84,9 +94,7 @@ TEST_CASE("coloured sweeps: pyramid20 is bit-identical on 1 and 2 threads and st
     return std::make_pair(pyramidState(s), scenes::measurePyramid(s));
   };
   const auto [one, m1] = run(1);
-  setNumThreads(2);
-  const bool twoThreads = getNumThreads() == 2;  // 1 when built without OpenMP: the check below is then trivial
-  setNumThreads(1);
+  const bool twoThreads = twoThreadsAvailable();  // false without OpenMP: the check below is then trivial
   const auto [two, m2] = run(2);
   WARN_MESSAGE(twoThreads, "built without OpenMP: the 2-thread run used one thread");
   REQUIRE(one.size() == two.size());
@@ -180,9 +188,7 @@ std::pair<std::vector<Real>, scenes::PyramidMetrics> runPartitioned(int threads,
 }  // namespace
 
 TEST_CASE("partitioned sweeps: pyramid20 is bit-identical on 1 and 2 threads, with and without the shock pass") {
-  setNumThreads(2);
-  const bool twoThreads = getNumThreads() == 2;  // 1 when built without OpenMP: the check below is then trivial
-  setNumThreads(1);
+  const bool twoThreads = twoThreadsAvailable();  // false without OpenMP: the check below is then trivial
   WARN_MESSAGE(twoThreads, "built without OpenMP: the 2-thread run used one thread");
   for (const bool shock : {true, false}) {
     CAPTURE(shock);
@@ -231,9 +237,7 @@ TEST_CASE("contact rows built on two threads: the serial build's bits for every 
   // friction anchors (Solver::setUseFrictionAnchors: each group lists its anchored manifolds, joined in row
   // order). 90 steps: the spheres fall 1.7 m and land at about step 35 (0.59 s at 60 Hz), and for the rest the
   // contacts' warm starts and anchors are in use.
-  setNumThreads(2);
-  const bool twoThreads = getNumThreads() == 2;
-  setNumThreads(1);
+  const bool twoThreads = twoThreadsAvailable();
   for (int variant = 0; variant < 4; ++variant) {
     CAPTURE(variant);
     auto run = [variant](int threads, int& rowThreads, size_t& contacts) {
@@ -380,9 +384,7 @@ TEST_CASE("partitioned sweeps with the adaptive thread count: the probe schedule
   // pyramid20 on two threads with Solver::setUseAdaptiveSweepThreads (the default): the first kProbeSteps steps
   // run on two threads and the next kProbeSteps on one, then the faster count (host-dependent) for the hold.
   // Whatever the counts, the state after 40 steps must be the one-thread run's, bit for bit.
-  setNumThreads(2);
-  const bool twoThreads = getNumThreads() == 2;
-  setNumThreads(1);
+  const bool twoThreads = twoThreadsAvailable();
   if (!twoThreads) {
     WARN_MESSAGE(false, "built without OpenMP: no second thread to choose");
     return;
@@ -421,9 +423,7 @@ TEST_CASE("partitioned work that finds the team busy: the stats report the one t
   // on the calling thread alone. SolverStats must report the threads that ran, not those asked for, and the
   // state must stay the one-thread run's. pyramid20 (about 400 contacts: rows, sweeps and shock pass all ask
   // for two threads), the count fixed at two; steps 0-9 inside a job, 10-19 outside it, 20-29 inside again.
-  setNumThreads(2);
-  const bool twoThreads = getNumThreads() == 2;
-  setNumThreads(1);
+  const bool twoThreads = twoThreadsAvailable();
   if (!twoThreads) {
     WARN_MESSAGE(false, "built without OpenMP: no team to find busy");
     return;
@@ -461,9 +461,7 @@ TEST_CASE("partitioned work too small to split: the stats report the one thread 
   // they run on the calling thread whatever the count asked for. tower10 (10 contacts, 10 shock ranges) asks
   // for two threads and runs on one: SolverStats::numSweepThreads must say one. pyramid20 (about 400 units) runs
   // on two and must say two. Adaptive count off, so that two threads are asked for on every step.
-  setNumThreads(2);
-  const bool twoThreads = getNumThreads() == 2;
-  setNumThreads(1);
+  const bool twoThreads = twoThreadsAvailable();
   if (!twoThreads) {
     WARN_MESSAGE(false, "built without OpenMP: no second thread to ask for");
     return;
@@ -498,9 +496,7 @@ TEST_CASE("adaptive sweep threads: a probe whose two-thread steps find the team 
   // as a busy step. The choice must then be one thread: had the busy steps been timed as two threads' steps,
   // two threads would have won by that factor, and the hold after the probe would report two. The state must
   // also be the one-thread run's, bit for bit, under the same schedule of sweep counts.
-  setNumThreads(2);
-  const bool twoThreads = getNumThreads() == 2;
-  setNumThreads(1);
+  const bool twoThreads = twoThreadsAvailable();
   if (!twoThreads) {
     WARN_MESSAGE(false, "built without OpenMP: no second thread to choose");
     return;
