@@ -19,6 +19,7 @@
 #include "scenes/scenes.h"
 #include "scree/core/parallel.h"
 #include "scree/solver/pgs.h"
+#include "contact_rows.h"   // solver/src
 #include "sweep_threads.h"  // solver/src
 
 using namespace scree;
@@ -588,6 +589,50 @@ TEST_CASE("persistent team: every index once on its own thread, barrier order, n
   user();
   other.join();
   CHECK(total.load() == 800);  // every call's work done exactly once: 2 x 1 with the team, 1 x 2 without
+}
+
+TEST_CASE("chunks shared from both ends: each chunk once, thread 0 a prefix, thread 1 the rest") {
+  // contact_rows.h forChunksFromBothEnds (the grouped row build and store): every chunk must run exactly once,
+  // thread 0's chunks must be a prefix in ascending order and thread 1's the remaining suffix in descending
+  // order, on two threads, on one, and with the team busy; the thread that is ahead takes over the other's
+  // chunks (one thread is slowed down by 0.5 ms a chunk, so the other must run more than half of them).
+  struct Case {
+    int slow, threads;
+    bool busy;
+  };
+  const Case cases[] = {{1, 1, false}, {1, 1, true}, {1, 2, false}, {1, 2, true}, {0, 2, false}};
+  for (const uint32_t numChunks : {0u, 1u, 2u, 7u, 40u}) {
+    for (const auto& [slow, threads, busy] : cases) {
+      CAPTURE(numChunks);
+      CAPTURE(slow);
+      CAPTURE(threads);
+      CAPTURE(busy);
+      std::vector<int> runs(numChunks, 0);
+      std::vector<uint32_t> order[2];
+      std::thread::id caller = std::this_thread::get_id();
+      int ran = 0;
+      auto body = [&] {
+        ran = forChunksFromBothEnds(threads, numChunks, [&](uint32_t c) {
+          const int t = std::this_thread::get_id() == caller ? 0 : 1;
+          if (t == slow) std::this_thread::sleep_for(std::chrono::microseconds(500));
+          ++runs[c];
+          order[t].push_back(c);
+        });
+      };
+      if (busy) runTeam(2, [&](int t, int) {
+          if (t == 0) body();
+        });
+      else body();
+      CHECK(ran == (busy ? 1 : threads));
+      for (uint32_t c = 0; c < numChunks; ++c) CHECK(runs[c] == 1);
+      const size_t front = order[0].size();
+      for (size_t i = 0; i < front; ++i) CHECK(order[0][i] == i);
+      for (size_t i = 0; i < order[1].size(); ++i) CHECK(order[1][i] == numChunks - 1 - i);
+      CHECK(front + order[1].size() == numChunks);
+      if (ran == 1) CHECK(order[1].empty());
+      if (ran == 2 && numChunks == 40) CHECK((slow == 1 ? front : order[1].size()) > 20);
+    }
+  }
 }
 
 TEST_CASE("persistent team: a lost wake-up costs at most the sleep bound, not a hang") {

@@ -434,10 +434,12 @@ void buildContactRows(SimulationState& s) {
     // the same): region 0's contacts, region 1's, then the boundary's, each group in contact order. Region r's
     // rows then touch no movable body of the other region, so that PgsSolver::prepare can run the two regions'
     // rows on two threads and keep every body's warm-start sum in row order, and each region's rows are built
-    // on the thread that sweeps it. Each thread counts its groups' rows and points (thread 0 also the
-    // boundary's), one prefix sum places every contact, and each thread fills its groups in place, with a
-    // warm-start cursor and a list of anchored manifolds per group (joined in group order, i.e. row order). The
-    // layout is the same on any thread count, so are the bits.
+    // mostly on the thread that sweeps it. The groups' contacts are cut into runs of 16 (chunks), which the two
+    // threads share from both ends (contact_rows.h forChunksFromBothEnds: thread 0 from region 0's first, thread
+    // 1 from the boundary's last and then region 1's): they count the chunks' rows and points, one prefix sum
+    // places every contact, and they fill the chunks in place, each chunk with its own warm-start cursor, list
+    // of anchored manifolds (joined in chunk order, i.e. row order) and tallies. A contact's rows do not depend
+    // on which thread writes them: the layout is the same on any thread count, so are the bits.
     for (auto& list : s.contactGroups) list.clear();
     for (uint32_t ci = 0; ci < numContacts; ++ci) s.contactGroups[contactGroup(s, ci)].push_back(ci);
     auto& layout = s.contactLayout;
@@ -459,18 +461,26 @@ void buildContactRows(SimulationState& s) {
         s.rowGroupEnd[g] = uint32_t(s.rows.size());
       }
     } else {
-      auto owner = [](int g, int n) { return g < PgsPartition::kRegions ? g % n : 0; };
-      runTeam(threads, [&](int t, int n) {
-        if (t == 0) ran = std::min(ran, n);
+      // The groups' contacts in runs of kChunk, shared from both ends (contact_rows.h forChunksFromBothEnds):
+      // thread 0 from region 0's first, thread 1 from the boundary's last, then region 1's from its end.
+      constexpr uint32_t kChunk = 16;
+      auto& chunks = s.contactChunks;
+      chunks.clear();
+      for (int g = 0; g < G; ++g)
+        for (uint32_t i = 0; i < s.contactGroups[g].size(); i += kChunk)
+          chunks.push_back({uint32_t(g), i, std::min<uint32_t>(i + kChunk, uint32_t(s.contactGroups[g].size()))});
+      const uint32_t numChunks = uint32_t(chunks.size());
+      auto contactsOf = [&](uint32_t c, auto&& f) {
+        const std::vector<uint32_t>& list = s.contactGroups[chunks[c].group];
+        for (uint32_t i = chunks[c].first; i < chunks[c].last; ++i) f(list[i]);
+      };
+      ran = std::min(ran, forChunksFromBothEnds(threads, numChunks, [&](uint32_t c) {
         RowCursor scratch;
-        for (int g = 0; g < G; ++g) {
-          if (owner(g, n) != t) continue;
-          for (const uint32_t ci : s.contactGroups[g]) {
-            const auto [numRows, numPoints] = contactRows<RowMode::COUNT>(s, ci, k, scratch);
-            layout[ci] = {numRows, numPoints, 0, 0};
-          }
-        }
-      });
+        contactsOf(c, [&](uint32_t ci) {
+          const auto [numRows, numPoints] = contactRows<RowMode::COUNT>(s, ci, k, scratch);
+          layout[ci] = {numRows, numPoints, 0, 0};
+        });
+      }));
       uint32_t row = 0, point = 0, coupling = 0;
       for (int g = 0; g < G; ++g) {
         for (const uint32_t ci : s.contactGroups[g]) {
@@ -486,26 +496,31 @@ void buildContactRows(SimulationState& s) {
       s.rows.resize(row);  // each contact writes its rows' defaults (RowMode::FILL)
       s.pointRows.resize(point);
       s.couplings.resize(coupling);
-      for (auto& list : s.rowBuildAnchors) list.clear();
-      runTeam(threads, [&](int t, int n) {
-        if (t == 0) ran = std::min(ran, n);
-        for (int g = 0; g < G; ++g) {
-          if (owner(g, n) != t) continue;
-          RowCursor cur;  // on this thread's stack: the tallies are written per point (no shared cache line)
-          cur.anchors = &s.rowBuildAnchors[g];
-          for (const uint32_t ci : s.contactGroups[g]) {
-            const ContactLayout& l = layout[ci];
-            if (l.count == 0) continue;
-            cur.row = l.row;
-            cur.point = l.point;
-            cur.coupling = l.coupling;
-            contactRows<RowMode::FILL>(s, ci, k, cur);
-          }
-          tally[g] = cur;
-        }
-      });
+      if (s.chunkAnchors.size() < numChunks) s.chunkAnchors.resize(numChunks);
+      s.chunkTallies.resize(numChunks);
+      ran = std::min(ran, forChunksFromBothEnds(threads, numChunks, [&](uint32_t c) {
+        RowCursor cur;  // on this thread's stack: the tallies are written per point (no shared cache line)
+        cur.anchors = &s.chunkAnchors[c];
+        cur.anchors->clear();
+        contactsOf(c, [&](uint32_t ci) {
+          const ContactLayout& l = layout[ci];
+          if (l.count == 0) return;
+          cur.row = l.row;
+          cur.point = l.point;
+          cur.coupling = l.coupling;
+          contactRows<RowMode::FILL>(s, ci, k, cur);
+        });
+        s.chunkTallies[c] = {cur.numPoints, cur.numWarm, cur.numSolved, cur.nonIterative};
+      }));
       auto& active = s.frictionAnchors.active;
-      for (const auto& list : s.rowBuildAnchors) active.insert(active.end(), list.begin(), list.end());
+      for (uint32_t c = 0; c < numChunks; ++c) {
+        active.insert(active.end(), s.chunkAnchors[c].begin(), s.chunkAnchors[c].end());
+        const ChunkTally& ct = s.chunkTallies[c];
+        tally[0].numPoints += ct.numPoints;
+        tally[0].numWarm += ct.numWarm;
+        tally[0].numSolved += ct.numSolved;
+        tally[0].nonIterative = tally[0].nonIterative || ct.nonIterative;
+      }
     }
   }
   s.solverStats().numRowBuildThreads = ran;

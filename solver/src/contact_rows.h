@@ -23,11 +23,13 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <utility>
 #include <vector>
 
 #include "scree/core/math.h"
+#include "scree/core/parallel.h"
 
 namespace scree::detail {
 
@@ -53,6 +55,44 @@ struct ContactLayout {
   uint32_t row, point, coupling, count;
   uint32_t points = 0, entry = 0;
 };
+
+/// A run of one group's contacts for the grouped build and store (contact_rows.cpp, store_results.cpp): entries
+/// [first, last) of SimulationState::contactGroups[group].
+struct ContactChunk {
+  uint32_t group, first, last;
+};
+
+/// What the rows of one chunk tallied (contact_rows.cpp; summed in chunk order after the build).
+struct ChunkTally {
+  size_t numPoints = 0, numWarm = 0, numSolved = 0;
+  bool nonIterative = false;
+};
+
+/// Runs f(c) for every chunk c in [0, numChunks) on `threads` threads of the team (scree/core/parallel.h): thread
+/// 0 takes chunks from the front, thread 1 from the back, each claim one atomic add, until they meet; on one
+/// thread (or a busy team) thread 0 takes them all. For work whose result does not depend on which thread does
+/// a chunk (each chunk writes its own places). Returns the fewest threads a job got (1 when the team was busy).
+///
+/// DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "The row build and the store shared from both
+/// ends"): the grouped row build and the store gave each region's contacts to the region's thread, which
+/// balanced the counts (pyramid20: 191, 190 and the boundary's 19) but not the times. With the host's cores
+/// trading lines fast, thread 0's share of the fill took about twice thread 1's: it runs the serial stages
+/// between the steps (the narrowphase, the events, the integration), whose data push its region's rows out of
+/// its cache, while thread 1's stay in its own. Where the lines trade slowly, thread 1's first reads of the
+/// contacts the narrowphase wrote made its count pass three times thread 0's. Sharing from both ends lets the
+/// thread that is ahead take over the other's last chunks: each region's contacts still go mostly to its thread.
+template <class F>
+int forChunksFromBothEnds(int threads, uint32_t numChunks, F&& f) {
+  threads = std::min(threads, 2);
+  int ran = threads;
+  std::atomic<uint32_t> claimed{0};
+  runTeam(threads, [&](int t, int n) {
+    if (t == 0) ran = n;
+    for (uint32_t mine = 0; claimed.fetch_add(1, std::memory_order_relaxed) < numChunks; ++mine)
+      f(t == 0 ? mine : numChunks - 1 - mine);
+  });
+  return ran;
+}
 
 /// The row range and solver bodies of one solved contact or constraint (the couplings of the shock order).
 struct CouplingRange {

@@ -124,7 +124,9 @@ struct SimulationState {
   // end of each group's rows (rows [rowGroupEnd[g - 1], rowGroupEnd[g]) are group g's) ----
   std::vector<uint32_t> contactGroups[PgsPartition::kRegions + 1];
   std::vector<ContactLayout> contactLayout;
-  std::vector<FrictionAnchorCache::Active> rowBuildAnchors[PgsPartition::kRegions + 1];
+  std::vector<ContactChunk> contactChunks;  // the groups' contacts in runs (contact_rows.h forChunksFromBothEnds)
+  std::vector<std::vector<FrictionAnchorCache::Active>> chunkAnchors;  // per chunk: its anchored manifolds
+  std::vector<ChunkTally> chunkTallies;                                 // per chunk: its rows' tallies
   uint32_t rowGroupEnd[PgsPartition::kRegions + 1] = {};
   bool rowGroupsReady = false;  // this step's contact rows are grouped (PgsSolver::prepare runs the regions apart)
   int rowGroupThreads = 1;      // the threads the grouped build asked for, which prepare asks for too

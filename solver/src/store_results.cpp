@@ -39,12 +39,13 @@ void storeResults(SimulationState& s) {
   };
   if (s.rowGroupsReady) {
     // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "Each thread lays out and takes down its
-    // region"): with the rows laid out by region (contact_rows.cpp), each group's contacts are stored on the
-    // thread that built, prepared and swept their rows, so the rows' impulses are read where they were written
-    // (on the program thread they crossed between the cores, and the next step's row build had to take the lines
-    // back). The entries keep the cache's order, contact order: each contact's entries go to the place the
-    // contacts before it leave free, and each contact's run is ordered by feature on its thread. Same entries in
-    // the same places on any thread count.
+    // region"): with the rows laid out by region (contact_rows.cpp), the contacts are stored on the two threads,
+    // in the row build's chunks shared from both ends (contact_rows.h forChunksFromBothEnds), so that each
+    // region's contacts are stored mostly on the thread that built, prepared and swept their rows, and the rows'
+    // impulses are read where they were written (on the program thread they crossed between the cores, and the
+    // next step's row build had to take the lines back). The entries keep the cache's order, contact order: each
+    // contact's entries go to the place the contacts before it leave free, and each contact's run is ordered by
+    // feature on its thread. Same entries in the same places on any thread count.
     auto& layout = s.contactLayout;
     uint32_t entries = 0;
     uint64_t lastPair = 0;
@@ -60,22 +61,25 @@ void storeResults(SimulationState& s) {
       firstPair = false;
     }
     s.warmStart.beginStorePlaced(entries);
-    constexpr int G = PgsPartition::kRegions + 1;
     const int threads = s.rowGroupThreads;
-    int ran = threads;
-    runTeam(threads, [&](int t, int n) {
-      if (t == 0) ran = std::min(ran, n);
-      for (int g = 0; g < G; ++g) {
-        if ((g < PgsPartition::kRegions ? g % n : 0) != t) continue;  // the row build's owners
-        for (const uint32_t ci : s.contactGroups[g]) {
-          const ContactLayout& l = layout[ci];
-          if (l.count == 0) continue;
-          for (uint32_t k = 0; k < l.points; ++k)
-            s.warmStart.set(l.entry + k, store(s.pointRows[l.point + k]));
-          s.warmStart.sortRun(l.entry, l.entry + l.points);
-        }
-      }
-    });
+    int ran = 1;
+    auto storeContact = [&](uint32_t ci) {
+      const ContactLayout& l = layout[ci];
+      if (l.count == 0) return;
+      for (uint32_t k = 0; k < l.points; ++k) s.warmStart.set(l.entry + k, store(s.pointRows[l.point + k]));
+      s.warmStart.sortRun(l.entry, l.entry + l.points);
+    };
+    if (threads > 1) {
+      // The row build's chunks (contact_rows.cpp), shared from both ends (contact_rows.h forChunksFromBothEnds).
+      const auto& chunks = s.contactChunks;
+      ran = forChunksFromBothEnds(threads, uint32_t(chunks.size()), [&](uint32_t c) {
+        const std::vector<uint32_t>& list = s.contactGroups[chunks[c].group];
+        for (uint32_t i = chunks[c].first; i < chunks[c].last; ++i) storeContact(list[i]);
+      });
+    } else {
+      for (const auto& list : s.contactGroups)
+        for (const uint32_t ci : list) storeContact(ci);
+    }
     s.rowBuildTeamBusy = s.rowBuildTeamBusy || ran < threads;
     s.warmStart.commitPlaced(ascending);
   } else {
