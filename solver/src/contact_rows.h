@@ -76,11 +76,12 @@ struct ChunkTally {
 /// DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "The row build and the store shared from both
 /// ends"): the grouped row build and the store gave each region's contacts to the region's thread, which
 /// balanced the counts (pyramid20: 191, 190 and the boundary's 19) but not the times. With the host's cores
-/// trading lines fast, thread 0's share of the fill took about twice thread 1's: it runs the serial stages
-/// between the steps (the narrowphase, the events, the integration), whose data push its region's rows out of
-/// its cache, while thread 1's stay in its own. Where the lines trade slowly, thread 1's first reads of the
-/// contacts the narrowphase wrote made its count pass three times thread 0's. Sharing from both ends lets the
-/// thread that is ahead take over the other's last chunks: each region's contacts still go mostly to its thread.
+/// trading lines fast, perf gave thread 0's share of the fill about twice thread 1's samples (probably because
+/// thread 0 runs the serial stages between the steps, whose data push its region's rows out of its cache); where
+/// they trade lines slowly, thread 1's first reads of the contacts the narrowphase wrote made its count pass
+/// three times thread 0's. Sharing from both ends lets the thread that is ahead take over the other's last
+/// chunks, and each region's contacts still go mostly to its thread. Measured on pyramid20, two threads: 3-8 %
+/// faster in the slow state, no measurable change in the fast one.
 template <class F>
 int forChunksFromBothEnds(int threads, uint32_t numChunks, F&& f) {
   threads = std::min(threads, 2);
