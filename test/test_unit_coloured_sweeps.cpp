@@ -162,6 +162,33 @@ TEST_CASE("partition: regions share no dynamic body, the boundary touches both, 
   CHECK(seen.size() == p.units.size());
 }
 
+TEST_CASE("parallel shock pass schedule: each range waits for its frozen body's writer, only awaited ends publish") {
+  // Bodies 0-3 in region 0, 4-7 in region 1, body 8 static (no region: its supports go to list 0 and need no wait).
+  // The ranges (free body, frozen body) in support order; three of them rest on a body of the other region.
+  PgsPartition p;
+  p.bodyRegion = {0, 0, 0, 0, 1, 1, 1, 1, -1};
+  const std::pair<int, int> supports[] = {{0, 8}, {4, 8}, {1, 0}, {5, 4}, {2, 5}, {6, 1}, {3, 2}, {7, 6}, {3, 6}};
+  std::vector<PgsSolver::ShockRange> ranges;
+  for (const auto& [freeB, frozenB] : supports) ranges.push_back({0, 0, 1, freeB, frozenB});
+  PgsSolver::shockSchedule(ranges, 9, p);
+  // List 0 runs ranges 0, 2, 4, 6, 8. Range 4 rests on body 5, whose last writer before it is list 1's second
+  // range (range 3), so it waits for a count of 2; range 8 rests on body 6, written by list 1's third (range 5).
+  CHECK(p.shockList[0] == std::vector<uint32_t>{0, 2, 4, 6, 8});
+  CHECK(p.shockWait[0] == std::vector<uint32_t>{0, 0, 2, 0, 3});
+  // List 1 runs ranges 1, 3, 5, 7; range 5 rests on body 1, written by list 0's second (range 2). Range 7 rests on
+  // body 6 of its own list: no wait.
+  CHECK(p.shockList[1] == std::vector<uint32_t>{1, 3, 5, 7});
+  CHECK(p.shockWait[1] == std::vector<uint32_t>{0, 0, 2, 0});
+  // Only the ends that are waited for publish their count: list 0's second range, list 1's second and third.
+  CHECK(p.shockPublish[0] == std::vector<uint8_t>{0, 1, 0, 0, 0});
+  CHECK(p.shockPublish[1] == std::vector<uint8_t>{0, 1, 1, 0});
+  // Rebuilt from scratch on the next call (no flag left from the last one).
+  const std::vector<PgsSolver::ShockRange> inside = {{0, 0, 1, 0, 8}, {0, 0, 1, 4, 8}, {0, 0, 1, 1, 0}};
+  PgsSolver::shockSchedule(inside, 9, p);
+  CHECK(p.shockPublish[0] == std::vector<uint8_t>{0, 0});
+  CHECK(p.shockPublish[1] == std::vector<uint8_t>{0});
+}
+
 namespace {
 /// pyramid20's state (positions, velocities, angular velocities, the top's rotation) after `steps` steps (0: the
 /// scene's 600) with partitioned sweeps on `threads` threads.

@@ -213,6 +213,9 @@ struct PgsPartition {
   std::vector<uint32_t> shockList[kRegions];
   std::vector<uint32_t> shockWait[kRegions];
   std::vector<uint32_t> shockDone;  ///< per solver body: 1 + position of its last writer in its region's list
+  /// Per range of a list: 1 when a range of the other list waits for the count this range's end reaches (its
+  /// thread then publishes that count); the other ranges' ends are not published.
+  std::vector<uint8_t> shockPublish[kRegions];
   /// Cap on the threads of the partitioned sweeps and shock pass (0: scree::getNumThreads()); at most one thread
   /// per region either way. The solve stage sets it from its measurements (Solver::setUseAdaptiveSweepThreads).
   int maxThreads = 0;
@@ -322,6 +325,10 @@ class PgsSolver {
   static void shockPass(std::vector<ConstraintRow>& rows, std::vector<SolverBodyState>& bodies,
                         const std::vector<ShockRange>& ranges, int maxSweeps, const PgsBlocks* blocks,
                         PgsPartition& partition, const ShockRecord& record = {});
+  /// The parallel shock pass's schedule (called by it): each range's list (its free body's region), the count of
+  /// the other list's ranges it waits for, and which ranges' ends are published (PgsPartition::shockList,
+  /// shockWait, shockPublish). `numBodies` solver bodies.
+  static void shockSchedule(const std::vector<ShockRange>& ranges, size_t numBodies, PgsPartition& partition);
 
  private:
   /// The cutting plane and the bodies' regions (pgs_partition.cpp).
