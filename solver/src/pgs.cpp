@@ -1976,9 +1976,9 @@ Real PgsSolver::iterate(std::vector<ConstraintRow>& rows, std::vector<SolverBody
 // Each publish is a store to a line the other thread is reading while it waits, so about 200 of them per pass in
 // pyramid20 (one per support) kept taking that line between the cores. A waiter needs only the count its range
 // waits for, so only the ranges whose end some range of the other list waits for publish; the counts are the same,
-// so is every range's wait, and so are the bits. pyramid20 partitioned on two threads (bench_rigid_stages, Intel
-// Xeon KVM guest, 5 interleaved rounds, medians of 3): 0.4497 ms per step against 0.4648, the solve stage 0.268 ms
-// against 0.280, faster in 5 of 5 rounds.
+// so is every range's wait, and so are the bits. pyramid20 partitioned on two threads (bench_rigid_stages, an Intel
+// Xeon KVM guest, 11 interleaved rounds in two runs, medians of 3 repetitions): 0.451 ms per step against 0.464
+// (median of the rounds), faster in 7 of the 11 (6 of 6 in one run, 1 of 5 in the other): a small gain.
 void PgsSolver::shockSchedule(const std::vector<ShockRange>& ranges, size_t nb, PgsPartition& p) {
   constexpr int R = PgsPartition::kRegions;
   auto listOf = [&](int32_t b) {
