@@ -163,7 +163,8 @@ TEST_CASE("partition: regions share no dynamic body, the boundary touches both, 
 }
 
 TEST_CASE("parallel shock pass schedule: each range waits for its frozen body's writer, only awaited ends publish") {
-  // Bodies 0-3 in region 0, 4-7 in region 1, body 8 static (no region: its supports go to list 0 and need no wait).
+  // Bodies 0-3 in region 0, 4-7 in region 1, body 8 static (no region, and no range writes it: resting on it never
+  // waits).
   // The ranges (free body, frozen body) in support order; three of them rest on a body of the other region.
   PgsPartition p;
   p.bodyRegion = {0, 0, 0, 0, 1, 1, 1, 1, -1};
