@@ -139,6 +139,63 @@ TEST_CASE("the position projection leaves motion within its tolerance to SPOOK" 
   CHECK(lossTight > lossOff + 0.1);  // 5 s at (omega h)^2 ~ 1e-3 per step of ~5 J: ~0.5 J
 }
 
+TEST_CASE("the position projection corrects rigid rows to its tolerance and leaves compliant ones to SPOOK" *
+          test::needsDirectSolver()) {
+  // A 1 kg box on a DIRECT Hinge to the world (axis z through its centre), no gravity, set 0.05 m along the axis
+  // from its anchor and tilted 0.05 rad about x. Rigid rows (the default compliance): one step's SPOOK correction
+  // (about 4/9 of the error at the default damping) leaves some 0.03 m and 0.03 rad, so the projection pulls back
+  // what exceeds the tolerance and ends with the error AT the tolerance: the axial offset (row TRANSLATIONAL_3)
+  // and the tilt's sine (the bending row n_A . y; the hinge frame in the world is the identity for axis z) equal
+  // 2 mm, up to the Newton stop (1e-3 of the tolerance) and the rows' elastic stretch (compliance 1e-10 times
+  // about 1 N s over h: 1e-8). The axial row is linear in the displacement, so one Newton step lands on the
+  // tolerance; the tilt's sine is not: turned back by d ~ 0.026 rad from ~0.028, it falls below the linearised
+  // target by about d^2 sin(theta) / 2 < 0.03^3 / 2 = 1.35e-5, inside the tolerance, where Newton stops. The
+  // linear rows are classified by their mass terms alone, the bending rows
+  // (no linear part) by the full metric with the inertia: both paths are crossed. Compliant rows (compliance 1,
+  // far above 1 % of the mass term) are not projected at all: the step is bit for bit the one without it.
+  constexpr Real kTol = 2e-3, kOffset = 0.05, kTilt = 0.05;
+  struct Result {
+    Vec3 position;
+    Quat rotation;
+    size_t projections;
+    Real drift;
+  };
+  auto run = [&](bool projection, Real compliance) {
+    test::TestWorld w(1.0 / 60.0, 0.0);
+    w.sim->getSolver().setUsePositionProjection(projection);
+    w.sim->getSolver().setPositionProjectionTolerance(kTol);
+    auto box = w.addBox(Vec3(0.1, 0.2, 0.3), Vec3::Zero(), 1.0);
+    auto hinge = std::make_shared<Hinge>(box, nullptr, Vec3::Zero(), Vec3::UnitZ());
+    hinge->setSolveType(FrictionModel::DIRECT);
+    if (compliance > 0) hinge->setCompliance(compliance);
+    w.sim->add(hinge);
+    box->setPosition(Vec3(0, 0, kOffset));
+    box->setRotation(Quat(Eigen::AngleAxis<Real>(kTilt, Vec3::UnitX())));
+    w.sim->stepForward();
+    const SolverStats& st = w.sim->getSolver().getStats();
+    return Result{box->getPosition(), box->getRotation(), st.numProjectionIterations, st.projectionDrift};
+  };
+  const Result rigid = run(true, -1);
+  const Real axial = rigid.position.z();
+  const Real tiltSine = -(rigid.rotation * Vec3::UnitZ()).y();
+  std::printf("projection of a hinge: %zu Newton iterations, drift before %.4f, after: axial %.7f m, tilt sine %.7f\n",
+              rigid.projections, rigid.drift, axial, tiltSine);
+  CHECK(rigid.projections >= 1);
+  CHECK(rigid.drift > 10 * kTol);
+  CHECK(std::abs(axial - kTol) <= 1e-3 * kTol + 1e-7);
+  CHECK(tiltSine <= kTol * (1 + 1e-3) + 1e-7);
+  CHECK(tiltSine >= kTol - 1.35e-5);
+  CHECK(std::abs(rigid.position.x()) <= 1e-9);
+  CHECK(std::abs(rigid.position.y()) <= 1e-9);
+
+  const Result soft = run(true, 1.0), softOff = run(false, 1.0);
+  CHECK(soft.projections == 0);
+  CHECK(soft.drift == 0.0);  // no row kept, so none reported
+  CHECK((soft.position - softOff.position).norm() == 0.0);
+  CHECK(soft.rotation.coeffs() == softOff.rotation.coeffs());
+  CHECK(soft.position.z() > 10 * kTol);  // the compliant joint's error was there to be projected
+}
+
 TEST_CASE("a PGS chain that comes apart is reported, not silent") {
   // chain20 hanging with PGS at 10 iterations diverges to ~1e11 m while staying finite. The step report names
   // the joints whose error beyond the elastic stretch exceeds the threshold (0.1 m), and each is logged once as

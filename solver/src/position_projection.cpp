@@ -40,20 +40,30 @@ void projectPositions(SimulationState& s) {
   // rotations it applies feed energy into the whip; the tension term makes those rotations as costly as the
   // force they turn against, and Newton converges in a few iterations (docs/solver-internals.md).
   const size_t nb = s.bodies.size();
-  s.projBodies.resize(nb);
-  const bool tension = computeGeometricStiffness(s);
-  for (size_t i = 0; i < nb; ++i) {
-    const RigidBody& b = *s.bodies[i];
-    SolverBodyState& pb = s.projBodies[i];
-    pb.v.setZero();
-    pb.w.setZero();
-    const bool dyn = b.getMotionControl() == RigidBody::DYNAMICS;
-    pb.invMass = dyn ? b.getInvMass() : 0;
-    pb.invInertia = dyn ? b.getInvInertiaWorld() : Mat3::Zero();
-    if (dyn && tension && s.geomK[i] > 0)
-      pb.invInertia = (pb.invInertia.inverse() + (s.h * s.h * s.geomK[i]) * Mat3::Identity()).inverse();
-  }
+  // The metric is built on first use (issue 18, chain20's cost): most steps of a chain at rest or swinging
+  // within the tolerance need no factorisation, and a row whose linear mass term alone shows it rigid (every
+  // ball joint's row) needs no inertia to be classified (rigidByMass below). Built or not, the rows kept, the
+  // drift reported and every correction are the same.
+  bool metricReady = false;
+  auto buildMetric = [&] {
+    if (metricReady) return;
+    metricReady = true;
+    s.projBodies.resize(nb);
+    const bool tension = computeGeometricStiffness(s);
+    for (size_t i = 0; i < nb; ++i) {
+      const RigidBody& b = *s.bodies[i];
+      SolverBodyState& pb = s.projBodies[i];
+      pb.v.setZero();
+      pb.w.setZero();
+      const bool dyn = b.getMotionControl() == RigidBody::DYNAMICS;
+      pb.invMass = dyn ? b.getInvMass() : 0;
+      pb.invInertia = dyn ? b.getInvInertiaWorld() : Mat3::Zero();
+      if (dyn && tension && s.geomK[i] > 0)
+        pb.invInertia = (pb.invInertia.inverse() + (s.h * s.h * s.geomK[i]) * Mat3::Identity()).inverse();
+    }
+  };
   auto massTerm = [&](const ConstraintRow& r) {
+    buildMetric();
     Real k = 0;
     if (r.bodyA >= 0) {
       const SolverBodyState& pb = s.projBodies[r.bodyA];
@@ -64,6 +74,21 @@ void projectPositions(SimulationState& s) {
       k += pb.invMass * r.jLinB.squaredNorm() + r.jAngB.dot(pb.invInertia * r.jAngB);
     }
     return k;
+  };
+  // The test `kd > 0 && e < kRigid kd` without the metric, when the linear terms settle it: they are massTerm's
+  // own products, and the angular terms it adds are >= 0 (the inverse inertias are positive semi-definite; a
+  // rounding below zero would have to meet a row exactly at the threshold), so a row rigid by its linear terms
+  // is rigid by massTerm.
+  auto linearInvMass = [&](int32_t b) {
+    if (b < 0) return Real(0);
+    const RigidBody& body = *s.bodies[size_t(b)];
+    return body.getMotionControl() == RigidBody::DYNAMICS ? body.getInvMass() : Real(0);
+  };
+  auto rigidByMass = [&](const ConstraintRow& r) {
+    Real lin = 0;
+    if (r.bodyA >= 0) lin += linearInvMass(r.bodyA) * r.jLinA.squaredNorm();
+    if (r.bodyB >= 0) lin += linearInvMass(r.bodyB) * r.jLinB.squaredNorm();
+    return lin > 0 && r.e < kRigid * lin;
   };
   const int maxIterations = s.solver.getNumProjectionIterations();
   for (int it = 0;; ++it) {
@@ -82,8 +107,10 @@ void projectPositions(SimulationState& s) {
       for (size_t k = begin; k < s.projRows.size(); ++k) {
         ConstraintRow& r = s.projRows[k];  // edited in place, moved down only past dropped rows
         if (!r.holonomic || r.lo > -1e299 || r.hi < 1e299 || !std::isfinite(r.drift)) continue;
-        const Real kd = massTerm(r);
-        if (!(kd > 0) || !(r.e < kRigid * kd)) continue;
+        if (!rigidByMass(r)) {
+          const Real kd = massTerm(r);
+          if (!(kd > 0) || !(r.e < kRigid * kd)) continue;
+        }
         // Pull back only what exceeds the tolerance; rows within it are held where they are.
         r.rhs = -(r.drift - std::clamp(r.drift, -tolerance, tolerance));
         r.e = 0;
@@ -104,6 +131,7 @@ void projectPositions(SimulationState& s) {
     if (it == 0) st.projectionDrift = worst;
     else st.projectionResidual = excess;
     if (excess <= 1e-3 * tolerance || it == maxIterations) break;
+    buildMetric();
     PgsSolver::prepare(s.projRows, s.projBodies);
     s.projSet.resize(s.projRows.size());
     for (uint32_t k = 0; k < s.projSet.size(); ++k) s.projSet[k] = k;
