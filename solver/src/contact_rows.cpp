@@ -34,9 +34,12 @@ struct RowBuildSettings {
 struct RowCursor {
   uint32_t row = 0, point = 0, coupling = 0;
   size_t warmCursor = 0;  ///< WarmStartCache::pairRangeAscending's
-  size_t numPoints = 0, numWarm = 0, numSolved = 0;
-  bool nonIterative = false;
+  ChunkTally tally;       ///< points, warm-started points, solved contacts, non-iterative rows; a layout mismatch
   std::vector<FrictionAnchorCache::Active>* anchors = nullptr;  ///< this thread's anchored manifolds
+  /// FILL on a guessed layout (last step's counts): the contact's expected row and point counts. A contact whose
+  /// counts differ writes nothing and sets tally.mismatch.
+  bool verify = false;
+  uint32_t expectRows = 0, expectPoints = 0;
 };
 
 /// The rows of contact ci: returns how many rows and contact points it takes ({0, 0}: not solved) and, unless
@@ -168,7 +171,12 @@ std::pair<uint32_t, uint32_t> contactRows(SimulationState& s, uint32_t ci, const
   if (manifoldFriction) nFriction = 3;
   const uint32_t numRows = nFriction + nActive;
   if constexpr (mode == RowMode::COUNT) return {numRows, nActive};
-  if (solveType != FrictionModel::ITERATIVE) cur.nonIterative = true;
+  if constexpr (mode == RowMode::FILL)
+    if (cur.verify && (numRows != cur.expectRows || nActive != cur.expectPoints)) {
+      cur.tally.mismatch = true;
+      return {};
+    }
+  if (solveType != FrictionModel::ITERATIVE) cur.tally.nonIterative = true;
   const uint64_t pair = contactPairKey(c);
   const Vec3 xa = ia >= 0 ? BodyAccess::cm(*s.bodies[ia]) : zero;
   const Vec3 xb = ib >= 0 ? BodyAccess::cm(*s.bodies[ib]) : zero;
@@ -177,7 +185,7 @@ std::pair<uint32_t, uint32_t> contactRows(SimulationState& s, uint32_t ci, const
   const Vec3 vb0 = ib >= 0 ? s.vStart[ib] : zero, wb0 = ib >= 0 ? s.wStart[ib] : zero;
   const Vec3 vaF = ia >= 0 ? s.sb[ia].v : zero, waF = ia >= 0 ? s.sb[ia].w : zero;
   const Vec3 vbF = ib >= 0 ? s.sb[ib].v : zero, wbF = ib >= 0 ? s.sb[ib].w : zero;
-  ++cur.numSolved;
+  ++cur.tally.numSolved;
   // The new rows are copies of the default row (constraint_row.h), filled in place below (setPointJacobian,
   // contact_law.h).
   if constexpr (mode == RowMode::APPEND) {
@@ -212,12 +220,12 @@ std::pair<uint32_t, uint32_t> contactRows(SimulationState& s, uint32_t ci, const
   for (uint32_t pi = 0; pi < pts.size(); ++pi) {
     ContactPoint& p = pts[pi];
     if (!p.enabled) continue;
-    ++cur.numPoints;
+    ++cur.tally.numPoints;
     const uint32_t ak = activeIndex++;
     const Vec3& n = p.normal;
     const Vec3 ra = p.point - xa, rb = p.point - xb;
     const WarmStartCache::Entry* ce = k.warm ? WarmStartCache::find(warmRange, p.featureId, p.point) : nullptr;
-    if (ce) ++cur.numWarm;
+    if (ce) ++cur.tally.numWarm;
 
     // --- normal row (contact_law.h) ---
     ConstraintRow& r = s.rows[nextNormal];
@@ -428,6 +436,7 @@ void buildContactRows(SimulationState& s) {
     s.couplings.clear();
     tally[0].anchors = &s.frictionAnchors.active;
     for (uint32_t ci = 0; ci < numContacts; ++ci) contactRows<RowMode::APPEND>(s, ci, k, tally[0]);
+    s.contactLayoutValid = false;
   } else {
     // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "The contact rows by region"): the contacts
     // laid out by group, by the last step's region map (the partition keeps its cut while the scene's units stay
@@ -441,7 +450,16 @@ void buildContactRows(SimulationState& s) {
     // of anchored manifolds (joined in chunk order, i.e. row order) and tallies. A contact's rows do not depend
     // on which thread writes them: the layout is the same on any thread count, so are the bits.
     for (auto& list : s.contactGroups) list.clear();
-    for (uint32_t ci = 0; ci < numContacts; ++ci) s.contactGroups[contactGroup(s, ci)].push_back(ci);
+    // Last step's layout is a good guess for this step's when the contacts are the same pairs in the same order
+    // (a steady scene); see the two-thread build below.
+    bool samePairs = s.contactLayoutValid && s.contactLayoutPairs.size() == numContacts;
+    s.contactLayoutPairs.resize(numContacts);
+    for (uint32_t ci = 0; ci < numContacts; ++ci) {
+      s.contactGroups[contactGroup(s, ci)].push_back(ci);
+      const uint64_t pair = contactPairKey(s.contacts[ci]);
+      samePairs = samePairs && s.contactLayoutPairs[ci] == pair;
+      s.contactLayoutPairs[ci] = pair;
+    }
     auto& layout = s.contactLayout;
     layout.resize(numContacts);
     if (threads == 1) {
@@ -474,64 +492,95 @@ void buildContactRows(SimulationState& s) {
         const std::vector<uint32_t>& list = s.contactGroups[chunks[c].group];
         for (uint32_t i = chunks[c].first; i < chunks[c].last; ++i) f(list[i]);
       };
-      ran = std::min(ran, forChunksFromBothEnds(threads, numChunks, [&](uint32_t c) {
-        RowCursor scratch;
-        contactsOf(c, [&](uint32_t ci) {
-          const auto [numRows, numPoints] = contactRows<RowMode::COUNT>(s, ci, k, scratch);
-          layout[ci] = {numRows, numPoints, 0, 0};
-        });
-      }));
-      uint32_t row = 0, point = 0, coupling = 0;
-      for (int g = 0; g < G; ++g) {
-        for (const uint32_t ci : s.contactGroups[g]) {
-          ContactLayout& l = layout[ci];
-          const uint32_t numRows = l.row, numPoints = l.point;
-          l = {row, point, coupling, numRows, numPoints};
-          row += numRows;
-          point += numPoints;
-          coupling += numRows > 0 ? 1 : 0;
+      // One prefix sum over the groups places every contact from its row and point counts (layout[ci].count,
+      // .points on entry); then the rows are sized for the fill.
+      auto place = [&] {
+        uint32_t row = 0, point = 0, coupling = 0;
+        for (int g = 0; g < G; ++g) {
+          for (const uint32_t ci : s.contactGroups[g]) {
+            ContactLayout& l = layout[ci];
+            const uint32_t numRows = l.count, numPoints = l.points;
+            l = {row, point, coupling, numRows, numPoints};
+            row += numRows;
+            point += numPoints;
+            coupling += numRows > 0 ? 1 : 0;
+          }
+          s.rowGroupEnd[g] = row;
         }
-        s.rowGroupEnd[g] = row;
-      }
-      s.rows.resize(row);  // each contact writes its rows' defaults (RowMode::FILL)
-      s.pointRows.resize(point);
-      s.couplings.resize(coupling);
+        s.rows.resize(row);  // each contact writes its rows' defaults (RowMode::FILL)
+        s.pointRows.resize(point);
+        s.couplings.resize(coupling);
+      };
       if (s.chunkAnchors.size() < numChunks) s.chunkAnchors.resize(numChunks);
       s.chunkTallies.resize(numChunks);
-      ran = std::min(ran, forChunksFromBothEnds(threads, numChunks, [&](uint32_t c) {
-        RowCursor cur;  // on this thread's stack: the tallies are written per point (no shared cache line)
-        cur.anchors = &s.chunkAnchors[c];
-        cur.anchors->clear();
-        contactsOf(c, [&](uint32_t ci) {
-          const ContactLayout& l = layout[ci];
-          if (l.count == 0) return;
-          cur.row = l.row;
-          cur.point = l.point;
-          cur.coupling = l.coupling;
-          contactRows<RowMode::FILL>(s, ci, k, cur);
-        });
-        s.chunkTallies[c] = {cur.numPoints, cur.numWarm, cur.numSolved, cur.nonIterative};
-      }));
+      // The fill; with verify, every contact (solved or not last step) checks its counts against the layout.
+      auto fill = [&](bool verify) {
+        bool mismatch = false;
+        ran = std::min(ran, forChunksFromBothEnds(threads, numChunks, [&](uint32_t c) {
+          RowCursor cur;  // on this thread's stack: the tallies are written per point (no shared cache line)
+          cur.anchors = &s.chunkAnchors[c];
+          cur.anchors->clear();
+          cur.verify = verify;
+          contactsOf(c, [&](uint32_t ci) {
+            const ContactLayout& l = layout[ci];
+            if (l.count == 0 && !verify) return;
+            cur.row = l.row;
+            cur.point = l.point;
+            cur.coupling = l.coupling;
+            cur.expectRows = l.count;
+            cur.expectPoints = l.points;
+            if (contactRows<RowMode::FILL>(s, ci, k, cur).first == 0 && l.count > 0) cur.tally.mismatch = true;
+          });
+          s.chunkTallies[c] = cur.tally;
+        }));
+        for (uint32_t c = 0; c < numChunks; ++c) mismatch = mismatch || s.chunkTallies[c].mismatch;
+        return !mismatch;
+      };
+      // DESIGN (issue 18, two-thread scaling, stop 50; docs/solver-internals.md "The row build on last step's
+      // layout"): the fill must know where each contact's rows go, and a count pass over every contact (most of
+      // a contact's work up to its manifold's axes) cost a quarter of the fill. When the contacts are the same
+      // pairs in the same order as last step's, their counts usually are too: the contacts are placed by last
+      // step's counts and filled at once, each contact checking its counts before it writes anything. If one
+      // differs, nothing it wrote is kept: the counts are taken afresh and every contact is filled again. Either
+      // way the layout is the one the count gives, so the bits are the same.
+      bool placed = false;
+      if (samePairs) {
+        place();
+        placed = fill(true);
+      }
+      if (!placed) {
+        ran = std::min(ran, forChunksFromBothEnds(threads, numChunks, [&](uint32_t c) {
+          RowCursor scratch;
+          contactsOf(c, [&](uint32_t ci) {
+            const auto [numRows, numPoints] = contactRows<RowMode::COUNT>(s, ci, k, scratch);
+            layout[ci].count = numRows;
+            layout[ci].points = numPoints;
+          });
+        }));
+        place();
+        fill(false);
+      }
       auto& active = s.frictionAnchors.active;
       for (uint32_t c = 0; c < numChunks; ++c) {
         active.insert(active.end(), s.chunkAnchors[c].begin(), s.chunkAnchors[c].end());
         const ChunkTally& ct = s.chunkTallies[c];
-        tally[0].numPoints += ct.numPoints;
-        tally[0].numWarm += ct.numWarm;
-        tally[0].numSolved += ct.numSolved;
-        tally[0].nonIterative = tally[0].nonIterative || ct.nonIterative;
+        tally[0].tally.numPoints += ct.numPoints;
+        tally[0].tally.numWarm += ct.numWarm;
+        tally[0].tally.numSolved += ct.numSolved;
+        tally[0].tally.nonIterative = tally[0].tally.nonIterative || ct.nonIterative;
       }
     }
+    s.contactLayoutValid = true;
   }
   s.solverStats().numRowBuildThreads = ran;
   s.rowBuildTeamBusy = ran < threads;
   size_t numPoints = 0, numWarm = 0, numSolvedContacts = 0;
   bool nonIterative = false;
   for (const RowCursor& c : tally) {
-    numPoints += c.numPoints;
-    numWarm += c.numWarm;
-    numSolvedContacts += c.numSolved;
-    nonIterative = nonIterative || c.nonIterative;
+    numPoints += c.tally.numPoints;
+    numWarm += c.tally.numWarm;
+    numSolvedContacts += c.tally.numSolved;
+    nonIterative = nonIterative || c.tally.nonIterative;
   }
   s.nonIterativeRows = nonIterative;
 

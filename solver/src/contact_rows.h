@@ -62,10 +62,13 @@ struct ContactChunk {
   uint32_t group, first, last;
 };
 
-/// What the rows of one chunk tallied (contact_rows.cpp; summed in chunk order after the build).
+/// What the rows of one chunk (or of the serial build) tallied (contact_rows.cpp; summed in chunk order after the
+/// build). mismatch: a contact of a fill on last step's layout (contact_rows.cpp) found its row or point count
+/// changed and wrote nothing.
 struct ChunkTally {
   size_t numPoints = 0, numWarm = 0, numSolved = 0;
   bool nonIterative = false;
+  bool mismatch = false;
 };
 
 /// Runs f(c) for every chunk c in [0, numChunks) on `threads` threads of the team (scree/core/parallel.h): thread

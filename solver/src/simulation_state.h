@@ -124,6 +124,8 @@ struct SimulationState {
   // end of each group's rows (rows [rowGroupEnd[g - 1], rowGroupEnd[g]) are group g's) ----
   std::vector<uint32_t> contactGroups[PgsPartition::kRegions + 1];
   std::vector<ContactLayout> contactLayout;
+  std::vector<uint64_t> contactLayoutPairs;  // each contact's pair key when contactLayout was made
+  bool contactLayoutValid = false;           // contactLayout holds the last grouped build's counts
   std::vector<ContactChunk> contactChunks;  // the groups' contacts in runs (contact_rows.h forChunksFromBothEnds)
   std::vector<std::vector<FrictionAnchorCache::Active>> chunkAnchors;  // per chunk: its anchored manifolds
   std::vector<ChunkTally> chunkTallies;                                 // per chunk: its rows' tallies
