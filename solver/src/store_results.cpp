@@ -20,7 +20,8 @@ void storeResults(SimulationState& s) {
   };
   // Inlined into the loops below: called, it cost pyramid20's store about 12 % more instructions. Returns the
   // point's warm-start entry.
-  auto store = [&](const PointRows& pr) __attribute__((always_inline)) {
+  // pair: the contact's pair key (contactPairKey), which the grouped row build has kept per contact.
+  auto store = [&](const PointRows& pr, uint64_t pair) __attribute__((always_inline)) {
     GeometryContact& c = s.contacts[pr.contact];
     ContactPoint& p = c.points()[pr.point];
     const Real ln = s.rows[pr.normal].lambda;
@@ -35,7 +36,7 @@ void storeResults(SimulationState& s) {
     Vec3 fw = Vec3::Zero();
     if (pr.t1 >= 0) fw = warmLambda(pr.t1) * pr.tangent1 + warmLambda(pr.t1 + 1) * pr.tangent2;
     if (pr.twist >= 0) fw = pr.share * fw + warmLambda(pr.twist) * pr.twistArm;
-    return WarmStartCache::Entry{contactPairKey(c), p.featureId, warmLambda(pr.normal), fw, pr.impactSpeed, p.point};
+    return WarmStartCache::Entry{pair, p.featureId, warmLambda(pr.normal), fw, pr.impactSpeed, p.point};
   };
   if (s.rowGroupsReady) {
     // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "Each thread lays out and takes down its
@@ -55,7 +56,9 @@ void storeResults(SimulationState& s) {
       if (l.count == 0) continue;
       l.entry = entries;
       entries += l.points;
-      const uint64_t pair = contactPairKey(s.contacts[ci]);
+      // The row build's copy of the key (contact_rows.cpp): reading it from the contact would load both
+      // geometries of every contact on this thread.
+      const uint64_t pair = s.contactLayoutPairs[ci];
       ascending = ascending && (firstPair || pair > lastPair);
       lastPair = pair;
       firstPair = false;
@@ -66,7 +69,8 @@ void storeResults(SimulationState& s) {
     auto storeContact = [&](uint32_t ci) {
       const ContactLayout& l = layout[ci];
       if (l.count == 0) return;
-      for (uint32_t k = 0; k < l.points; ++k) s.warmStart.set(l.entry + k, store(s.pointRows[l.point + k]));
+      const uint64_t pair = s.contactLayoutPairs[ci];
+      for (uint32_t k = 0; k < l.points; ++k) s.warmStart.set(l.entry + k, store(s.pointRows[l.point + k], pair));
       s.warmStart.sortRun(l.entry, l.entry + l.points);
     };
     if (threads > 1) {
@@ -84,7 +88,7 @@ void storeResults(SimulationState& s) {
     s.warmStart.commitPlaced(ascending);
   } else {
     s.warmStart.beginStore();
-    for (const PointRows& pr : s.pointRows) s.warmStart.add(store(pr));
+    for (const PointRows& pr : s.pointRows) s.warmStart.add(store(pr, contactPairKey(s.contacts[pr.contact])));
     s.warmStart.commit();
   }
   storeFrictionAnchors(s);  // issue 18 (friction anchors, friction_anchor.h): keep the anchors that stick
