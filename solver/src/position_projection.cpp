@@ -44,6 +44,9 @@ void projectPositions(SimulationState& s) {
   // within the tolerance need no factorisation, and a row whose linear mass term alone shows it rigid (every
   // ball joint's row) needs no inertia to be classified (rigidByMass below). Built or not, the rows kept, the
   // drift reported and every correction are the same.
+  auto invMassOf = [](const RigidBody& b) {
+    return b.getMotionControl() == RigidBody::DYNAMICS ? b.getInvMass() : Real(0);
+  };
   bool metricReady = false;
   auto buildMetric = [&] {
     if (metricReady) return;
@@ -56,7 +59,7 @@ void projectPositions(SimulationState& s) {
       pb.v.setZero();
       pb.w.setZero();
       const bool dyn = b.getMotionControl() == RigidBody::DYNAMICS;
-      pb.invMass = dyn ? b.getInvMass() : 0;
+      pb.invMass = invMassOf(b);
       pb.invInertia = dyn ? b.getInvInertiaWorld() : Mat3::Zero();
       if (dyn && tension && s.geomK[i] > 0)
         pb.invInertia = (pb.invInertia.inverse() + (s.h * s.h * s.geomK[i]) * Mat3::Identity()).inverse();
@@ -79,15 +82,10 @@ void projectPositions(SimulationState& s) {
   // own products, and the angular terms it adds are >= 0 (the inverse inertias are positive semi-definite; a
   // rounding below zero would have to meet a row exactly at the threshold), so a row rigid by its linear terms
   // is rigid by massTerm.
-  auto linearInvMass = [&](int32_t b) {
-    if (b < 0) return Real(0);
-    const RigidBody& body = *s.bodies[size_t(b)];
-    return body.getMotionControl() == RigidBody::DYNAMICS ? body.getInvMass() : Real(0);
-  };
   auto rigidByMass = [&](const ConstraintRow& r) {
     Real lin = 0;
-    if (r.bodyA >= 0) lin += linearInvMass(r.bodyA) * r.jLinA.squaredNorm();
-    if (r.bodyB >= 0) lin += linearInvMass(r.bodyB) * r.jLinB.squaredNorm();
+    if (r.bodyA >= 0) lin += invMassOf(*s.bodies[size_t(r.bodyA)]) * r.jLinA.squaredNorm();
+    if (r.bodyB >= 0) lin += invMassOf(*s.bodies[size_t(r.bodyB)]) * r.jLinB.squaredNorm();
     return lin > 0 && r.e < kRigid * lin;
   };
   const int maxIterations = s.solver.getNumProjectionIterations();
