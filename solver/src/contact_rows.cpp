@@ -427,15 +427,15 @@ void buildContactRows(SimulationState& s) {
   const bool grouped = groupedBuild(s);
   const int threads = grouped ? rowBuildThreads(s) : 1;
   int ran = threads;  // the fewest threads a job of the build got (one if another Simulation held the team)
-  RowCursor tally[G];
+  RowCursor serial;  // the one-thread builds' cursor; after the build, every contact's tallies
   s.rowGroupsReady = grouped;
   s.rowGroupThreads = threads;
   if (!grouped) {
     s.rows.clear();
     s.pointRows.clear();
     s.couplings.clear();
-    tally[0].anchors = &s.frictionAnchors.active;
-    for (uint32_t ci = 0; ci < numContacts; ++ci) contactRows<RowMode::APPEND>(s, ci, k, tally[0]);
+    serial.anchors = &s.frictionAnchors.active;
+    for (uint32_t ci = 0; ci < numContacts; ++ci) contactRows<RowMode::APPEND>(s, ci, k, serial);
     s.contactLayoutValid = false;
   } else {
     // DESIGN (issue 18, two-thread scaling; docs/solver-internals.md "The contact rows by region"): the contacts
@@ -467,13 +467,13 @@ void buildContactRows(SimulationState& s) {
       s.rows.clear();
       s.pointRows.clear();
       s.couplings.clear();
-      tally[0].anchors = &s.frictionAnchors.active;
+      serial.anchors = &s.frictionAnchors.active;
       for (int g = 0; g < G; ++g) {
-        tally[0].warmCursor = 0;  // each group's contacts ascend
+        serial.warmCursor = 0;  // each group's contacts ascend
         for (const uint32_t ci : s.contactGroups[g]) {
           const uint32_t row = uint32_t(s.rows.size()), point = uint32_t(s.pointRows.size()),
                          coupling = uint32_t(s.couplings.size());
-          const uint32_t numRows = contactRows<RowMode::APPEND>(s, ci, k, tally[0]).first;
+          const uint32_t numRows = contactRows<RowMode::APPEND>(s, ci, k, serial).first;
           layout[ci] = {row, point, coupling, numRows, uint32_t(s.pointRows.size()) - point};
         }
         s.rowGroupEnd[g] = uint32_t(s.rows.size());
@@ -563,33 +563,22 @@ void buildContactRows(SimulationState& s) {
       auto& active = s.frictionAnchors.active;
       for (uint32_t c = 0; c < numChunks; ++c) {
         active.insert(active.end(), s.chunkAnchors[c].begin(), s.chunkAnchors[c].end());
-        const ChunkTally& ct = s.chunkTallies[c];
-        tally[0].tally.numPoints += ct.numPoints;
-        tally[0].tally.numWarm += ct.numWarm;
-        tally[0].tally.numSolved += ct.numSolved;
-        tally[0].tally.nonIterative = tally[0].tally.nonIterative || ct.nonIterative;
+        serial.tally += s.chunkTallies[c];
       }
     }
     s.contactLayoutValid = true;
   }
   s.solverStats().numRowBuildThreads = ran;
   s.rowBuildTeamBusy = ran < threads;
-  size_t numPoints = 0, numWarm = 0, numSolvedContacts = 0;
-  bool nonIterative = false;
-  for (const RowCursor& c : tally) {
-    numPoints += c.tally.numPoints;
-    numWarm += c.tally.numWarm;
-    numSolvedContacts += c.tally.numSolved;
-    nonIterative = nonIterative || c.tally.nonIterative;
-  }
-  s.nonIterativeRows = nonIterative;
+  const ChunkTally& t = serial.tally;
+  s.nonIterativeRows = t.nonIterative;
 
   SolverStats& st = s.solverStats();
-  st.numContacts = numSolvedContacts;
-  st.numContactPoints = numPoints;
-  st.numWarmStarted = numWarm;
+  st.numContacts = t.numSolved;
+  st.numContactPoints = t.numPoints;
+  st.numWarmStarted = t.numWarm;
   s.stats.numContacts = s.contacts.size();
-  s.stats.numContactPoints = numPoints;
+  s.stats.numContactPoints = t.numPoints;
 }
 
 void buildParticleRows(SimulationState& s) {

@@ -69,6 +69,14 @@ struct ChunkTally {
   size_t numPoints = 0, numWarm = 0, numSolved = 0;
   bool nonIterative = false;
   bool mismatch = false;
+  ChunkTally& operator+=(const ChunkTally& o) {
+    numPoints += o.numPoints;
+    numWarm += o.numWarm;
+    numSolved += o.numSolved;
+    nonIterative = nonIterative || o.nonIterative;
+    mismatch = mismatch || o.mismatch;
+    return *this;
+  }
 };
 
 /// Runs f(c) for every chunk c in [0, numChunks) on `threads` threads of the team (scree/core/parallel.h): thread
